@@ -1,0 +1,1 @@
+//! Estimator. Placeholder until written.

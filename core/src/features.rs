@@ -1,0 +1,1 @@
+//! Slice features (Sec. 4.3.1). Placeholder until written.

@@ -1,0 +1,37 @@
+//! # digiteyes-core
+//!
+//! The tracking core of digiteyes: a `no_std`, allocation-free reproduction of the DigitEyes
+//! model-based hand tracker (J. Rehg, CMU-CS-95-138, 1995).
+//!
+//! One frame flows one way through the modules, named after the thesis' stages (Sec. 4.3.2):
+//!
+//! ```text
+//! model ─▶ kinematics ─▶ camera ─▶ features (slices on a frame) ─▶ estimator ─▶ tracker
+//! ```
+//!
+//! - [`model`]: the kinematic tree parsed from the `hand.dh` format (built-in: [`model::HAND_DH`]).
+//! - [`kinematics`]: link poses for a state vector and point derivatives (Eq. 2.16).
+//! - [`camera`]: calibrated pinhole cameras and their projection derivative.
+//! - [`frame`]: a borrowed 8-bit frame and bounds-checked sub-pixel sampling.
+//! - [`features`]: the slice edge search of Sec. 4.3.1 with occlusion masking.
+//! - [`estimator`]: residuals, row-by-row normal equations, conditioned Gauss–Newton (Eq. 2.22).
+//! - [`tracker`]: the per-frame loop and its report.
+//!
+//! Units everywhere: millimetres, radians, pixels (pixel (0, 0) is the centre of the top-left
+//! pixel). Numbers are `f32`. Every capacity is a named constant in [`config`]; exceeding one
+//! is a typed error or a counted condition, never a panic.
+#![no_std]
+#![deny(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod camera;
+pub mod config;
+pub mod estimator;
+pub mod features;
+pub mod frame;
+pub mod kinematics;
+pub mod model;
+pub mod quaternion;
+pub mod tracker;
+
+pub use nalgebra;

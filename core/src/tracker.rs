@@ -1,0 +1,1 @@
+//! Tracker. Placeholder until written.
