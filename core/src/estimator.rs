@@ -1,1 +1,463 @@
-//! Estimator. Placeholder until written.
+//! Residuals and the conditioned Gauss–Newton step (Sec. 2.5, Eq. 2.22).
+//!
+//! Residual rows are added one at a time to the normal equations `JᵀWJ` and `JᵀWr` (a full
+//! `J` is never stored); the step is `Δ = −(JᵀWJ + S)⁻¹ JᵀWr` with the constant diagonal
+//! conditioning matrix `S`, solved by Cholesky; only the free states change.
+//!
+//! Three residual kinds, each "predicted minus measured", in pixels:
+//! - **edge point**: the distance of a detected silhouette point from the predicted silhouette
+//!   line (the axis offset by the projected radius) — robustly weighted;
+//! - **axis line** (Eq. 2.17, the thesis' form): the distance of the projected model axis'
+//!   end points from the axis line fitted through a link's edge points;
+//! - **tip** (Eq. 2.19): the distance along the axis between the predicted and found tip.
+
+use heapless::Vec;
+use nalgebra::{SMatrix, SVector, Vector2};
+
+use crate::camera::Camera;
+use crate::config::{MAX_ROW_NONZEROS, MAX_STATES};
+use crate::features::{axis_frame, LinkFeatures};
+use crate::kinematics::Poses;
+use crate::model::{Model, BASE_STATES};
+use crate::projection::ProjectedLink;
+
+/// Which residuals a link's edge points give.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ResidualKind {
+    /// One row per edge point: its distance from the predicted silhouette line.
+    EdgePoints,
+    /// Two rows per link: the model axis' end points against the fitted axis line (Eq. 2.17).
+    AxisLines,
+}
+
+/// Robust weighting of residuals (px).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Robust {
+    /// Plain least squares.
+    None,
+    /// Huber: weight 1 up to `k` px, then `k / |r|`.
+    Huber(f32),
+    /// Tukey's biweight: `(1 − (r/c)²)²` up to `c` px, 0 beyond.
+    Tukey(f32),
+}
+
+impl Robust {
+    /// The weight of a residual `r` (px).
+    pub fn weight(&self, r: f32) -> f32 {
+        let a = r.abs();
+        match *self {
+            Robust::None => 1.0,
+            Robust::Huber(k) if a > k => k / a,
+            Robust::Huber(_) => 1.0,
+            Robust::Tukey(c) if a < c => {
+                let u = 1.0 - (r / c) * (r / c);
+                u * u
+            }
+            Robust::Tukey(_) => 0.0,
+        }
+    }
+}
+
+/// The diagonal of the conditioning matrix `S` per kind of state (Table 4.2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Conditioning {
+    /// For each quaternion state.
+    pub quaternion: f32,
+    /// For each translation state (per mm²).
+    pub translation: f32,
+    /// For each joint angle (per rad²).
+    pub joint: f32,
+}
+
+impl Conditioning {
+    /// The thesis' weights (Table 4.2): quaternion 1, translation 10, joint 1000.
+    pub const THESIS: Conditioning = Conditioning {
+        quaternion: 1.0,
+        translation: 10.0,
+        joint: 1000.0,
+    };
+
+    /// `S` for state `i`.
+    pub fn for_state(&self, i: usize) -> f32 {
+        match i {
+            0..=3 => self.quaternion,
+            4..=6 => self.translation,
+            _ => self.joint,
+        }
+    }
+}
+
+/// Parameters of the estimator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub struct EstimatorConfig {
+    /// Which residuals edges give.
+    pub residual: ResidualKind,
+    /// Robust weighting of edge and tip residuals.
+    pub robust: Robust,
+    /// The conditioning matrix `S`.
+    pub conditioning: Conditioning,
+    /// Weight of a tip row relative to an edge row.
+    pub tip_weight: f32,
+}
+
+impl Default for EstimatorConfig {
+    fn default() -> Self {
+        EstimatorConfig {
+            residual: ResidualKind::EdgePoints,
+            robust: Robust::Huber(2.0),
+            conditioning: Conditioning {
+                quaternion: 1.0,
+                translation: 1.0,
+                joint: 1000.0,
+            },
+            tip_weight: 1.0,
+        }
+    }
+}
+
+/// Which states the estimator may change: bit `i` for state `qi`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FreeMask(pub u32);
+
+impl FreeMask {
+    /// Every state of a model with `n` states.
+    pub fn all(n: usize) -> Self {
+        FreeMask(if n >= 32 { u32::MAX } else { (1u32 << n) - 1 })
+    }
+
+    /// Whether state `i` is free.
+    pub fn contains(&self, i: usize) -> bool {
+        i < 32 && self.0 & (1 << i) != 0
+    }
+
+    /// Number of free states.
+    pub fn count(&self) -> u32 {
+        self.0.count_ones()
+    }
+}
+
+/// How the image measurements of one link move with each state it depends on.
+#[derive(Debug, Clone, Default)]
+pub struct LinkJacobian {
+    /// The states, palm first then the link's joint chain.
+    pub states: Vec<u8, MAX_ROW_NONZEROS>,
+    /// `∂a/∂q` for the axis start in the image (px per unit state).
+    pub da: Vec<Vector2<f32>, MAX_ROW_NONZEROS>,
+    /// `∂b/∂q` for the axis end in the image.
+    pub db: Vec<Vector2<f32>, MAX_ROW_NONZEROS>,
+    /// `∂r0/∂q` for the projected radius at the start (px).
+    pub dr0: Vec<f32, MAX_ROW_NONZEROS>,
+    /// `∂r1/∂q` for the projected radius at the end (px).
+    pub dr1: Vec<f32, MAX_ROW_NONZEROS>,
+}
+
+impl LinkJacobian {
+    /// Computes the derivatives of link `link`'s image axis and radii (Eq. 2.16 through the
+    /// camera). Left empty if an end does not project.
+    pub fn compute(
+        &mut self,
+        model: &Model,
+        poses: &Poses,
+        camera: &Camera,
+        link: &ProjectedLink,
+    ) {
+        self.states.clear();
+        self.da.clear();
+        self.db.clear();
+        self.dr0.clear();
+        self.dr1.clear();
+        let frame = usize::from(link.frame);
+        let (Some((_, z0, j0)), Some((_, z1, j1))) = (
+            camera.project_with_jacobian(&link.p0),
+            camera.project_with_jacobian(&link.p1),
+        ) else {
+            return;
+        };
+        let depth_row = camera.r.row(2).into_owned();
+        let d0 = poses.point_derivatives(model, frame, &link.p0);
+        let d1 = poses.point_derivatives(model, frame, &link.p1);
+        for ((s, v0), (_, v1)) in d0.iter().zip(d1.iter()) {
+            let _ = self.states.push(*s);
+            let _ = self.da.push(j0 * v0);
+            let _ = self.db.push(j1 * v1);
+            let _ = self.dr0.push(-link.r0 / z0 * (depth_row * v0)[0]);
+            let _ = self.dr1.push(-link.r1 / z1 * (depth_row * v1)[0]);
+        }
+    }
+}
+
+/// The normal equations `JᵀWJ`, `JᵀWr` accumulated row by row, with residual statistics.
+#[derive(Debug, Clone)]
+pub struct NormalEquations {
+    jtj: SMatrix<f32, MAX_STATES, MAX_STATES>,
+    jtr: SVector<f32, MAX_STATES>,
+    sum_squares: f32,
+    rows: u16,
+}
+
+impl Default for NormalEquations {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl NormalEquations {
+    /// Empty equations.
+    pub fn new() -> Self {
+        NormalEquations {
+            jtj: SMatrix::zeros(),
+            jtr: SVector::zeros(),
+            sum_squares: 0.0,
+            rows: 0,
+        }
+    }
+
+    /// Clears for the next iteration.
+    pub fn clear(&mut self) {
+        self.jtj.fill(0.0);
+        self.jtr.fill(0.0);
+        self.sum_squares = 0.0;
+        self.rows = 0;
+    }
+
+    /// Adds one residual `r` (px) with derivative entries `(state, ∂r/∂q_state)` and weight
+    /// `w`; entries of states that are not free are dropped. Non-finite rows are ignored.
+    pub fn add_row(&mut self, entries: &[(u8, f32)], r: f32, w: f32, free: FreeMask) {
+        if !(r.is_finite() && w.is_finite()) || entries.iter().any(|(_, v)| !v.is_finite()) {
+            return;
+        }
+        self.sum_squares += r * r;
+        self.rows = self.rows.saturating_add(1);
+        if w == 0.0 {
+            return;
+        }
+        for (i, &(si, vi)) in entries.iter().enumerate() {
+            let si = usize::from(si);
+            if !free.contains(si) || si >= MAX_STATES {
+                continue;
+            }
+            let wv = w * vi;
+            self.jtr[si] += wv * r;
+            for &(sj, vj) in &entries[i..] {
+                let sj = usize::from(sj);
+                if free.contains(sj) && sj < MAX_STATES {
+                    let (lo, hi) = if si <= sj { (si, sj) } else { (sj, si) };
+                    self.jtj[(lo, hi)] += wv * vj;
+                }
+            }
+        }
+    }
+
+    /// Rows added since the last clear.
+    pub fn rows(&self) -> u16 {
+        self.rows
+    }
+
+    /// Root-mean-square of the (unweighted) residuals added (px).
+    pub fn rms(&self) -> f32 {
+        if self.rows == 0 {
+            0.0
+        } else {
+            libm::sqrtf(self.sum_squares / f32::from(self.rows))
+        }
+    }
+
+    /// The conditioned Gauss–Newton step `−(JᵀWJ + S)⁻¹ JᵀWr` for the free states (zero for
+    /// the others), or `None` if the system is not positive definite or not finite.
+    pub fn step(
+        &self,
+        n_states: usize,
+        free: FreeMask,
+        conditioning: &Conditioning,
+    ) -> Option<SVector<f32, MAX_STATES>> {
+        let mut a = self.jtj;
+        let mut b = self.jtr;
+        for i in 0..MAX_STATES {
+            for j in 0..i {
+                a[(i, j)] = a[(j, i)];
+            }
+            if i < n_states && free.contains(i) {
+                a[(i, i)] += conditioning.for_state(i);
+            } else {
+                a[(i, i)] = 1.0;
+                b[i] = 0.0;
+            }
+        }
+        let delta = -a.cholesky()?.solve(&b);
+        delta.iter().all(|v| v.is_finite()).then_some(delta)
+    }
+}
+
+/// A row of derivative entries.
+type Row = Vec<(u8, f32), MAX_ROW_NONZEROS>;
+
+/// What one link contributed to the normal equations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct LinkRows {
+    /// Edge or line rows added.
+    pub edges: u16,
+    /// Tip rows added.
+    pub tips: u16,
+}
+
+/// Adds the rows of one link's features to `ne`.
+pub fn add_link_rows(
+    ne: &mut NormalEquations,
+    link: &ProjectedLink,
+    features: &LinkFeatures,
+    jac: &LinkJacobian,
+    config: &EstimatorConfig,
+    free: FreeMask,
+) -> LinkRows {
+    let mut added = LinkRows::default();
+    if jac.states.is_empty() {
+        return added;
+    }
+    let (dir, normal) = axis_frame(&link.a, &link.b);
+    let axis = link.b - link.a;
+    let len2 = axis.norm_squared().max(1e-9);
+    let mut row = Row::new();
+    match config.residual {
+        ResidualKind::EdgePoints => {
+            for e in &features.edges {
+                let side = f32::from(e.side);
+                let s = ((e.position - link.a).dot(&axis) / len2).clamp(0.0, 1.0);
+                let measured = side * normal.dot(&(e.position - link.a));
+                let r = link.radius_at(s) - measured;
+                row.clear();
+                for k in 0..jac.states.len() {
+                    let moved = jac.da[k] * (1.0 - s) + jac.db[k] * s;
+                    let dr = jac.dr0[k] * (1.0 - s) + jac.dr1[k] * s;
+                    let _ = row.push((jac.states[k], side * normal.dot(&moved) + dr));
+                }
+                ne.add_row(&row, r, config.robust.weight(r), free);
+                added.edges += 1;
+            }
+        }
+        ResidualKind::AxisLines => {
+            if let Some((centre, line_normal)) = fit_axis_line(link, features) {
+                for (point, end) in [(link.a, 0usize), (link.b, 1)] {
+                    let r = line_normal.dot(&(point - centre));
+                    row.clear();
+                    for k in 0..jac.states.len() {
+                        let moved = if end == 0 { jac.da[k] } else { jac.db[k] };
+                        let _ = row.push((jac.states[k], line_normal.dot(&moved)));
+                    }
+                    ne.add_row(&row, r, 1.0, free);
+                    added.edges += 1;
+                }
+            }
+        }
+    }
+    if let Some(tip) = features.tip {
+        let r = dir.dot(&(link.b - tip)) + link.r1;
+        row.clear();
+        for k in 0..jac.states.len() {
+            let _ = row.push((jac.states[k], dir.dot(&jac.db[k]) + jac.dr1[k]));
+        }
+        ne.add_row(&row, r, config.tip_weight * config.robust.weight(r), free);
+        added.tips += 1;
+    }
+    added
+}
+
+/// Fits the axis line of a link through its edge points, each moved toward the axis by the
+/// projected radius (so one silhouette alone still gives the axis), rejecting points more than
+/// 2 px (or 3 median deviations) off a first fit. Returns a point on the line and its normal.
+pub fn fit_axis_line(
+    link: &ProjectedLink,
+    features: &LinkFeatures,
+) -> Option<(Vector2<f32>, Vector2<f32>)> {
+    let (_, normal) = axis_frame(&link.a, &link.b);
+    let axis = link.b - link.a;
+    let len2 = axis.norm_squared().max(1e-9);
+    let mut points: Vec<Vector2<f32>, { crate::features::MAX_LINK_EDGES }> = Vec::new();
+    for e in &features.edges {
+        let s = ((e.position - link.a).dot(&axis) / len2).clamp(0.0, 1.0);
+        let _ = points.push(e.position - normal * (f32::from(e.side) * link.radius_at(s)));
+    }
+    let first = total_least_squares(&points, None)?;
+    let mut deviations: Vec<f32, { crate::features::MAX_LINK_EDGES }> = Vec::new();
+    for p in &points {
+        let _ = deviations.push(first.1.dot(&(p - first.0)).abs());
+    }
+    let mut sorted = deviations.clone();
+    sorted.sort_unstable_by(|a, b| a.total_cmp(b));
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+    let limit = (3.0 * median).max(2.0);
+    total_least_squares(&points, Some((&deviations, limit))).or(Some(first))
+}
+
+fn total_least_squares(
+    points: &[Vector2<f32>],
+    keep: Option<(&[f32], f32)>,
+) -> Option<(Vector2<f32>, Vector2<f32>)> {
+    let kept = |i: usize| keep.is_none_or(|(d, limit)| d.get(i).is_some_and(|v| *v <= limit));
+    let mut n = 0.0f32;
+    let mut centre = Vector2::zeros();
+    for (i, p) in points.iter().enumerate() {
+        if kept(i) {
+            centre += p;
+            n += 1.0;
+        }
+    }
+    if n < 2.0 {
+        return None;
+    }
+    centre /= n;
+    let (mut sxx, mut sxy, mut syy) = (0.0f32, 0.0f32, 0.0f32);
+    for (i, p) in points.iter().enumerate() {
+        if kept(i) {
+            let d = p - centre;
+            sxx += d.x * d.x;
+            sxy += d.x * d.y;
+            syy += d.y * d.y;
+        }
+    }
+    // Direction of largest spread: angle of the principal axis of the 2×2 scatter matrix.
+    let angle = 0.5 * libm::atan2f(2.0 * sxy, sxx - syy);
+    let (s, c) = libm::sincosf(angle);
+    if sxx + syy < 1e-6 {
+        return None;
+    }
+    Some((centre, Vector2::new(-s, c)))
+}
+
+/// Applies a step to the free states of `q`, renormalises the quaternion and clamps joints to
+/// the model's ranges. Returns the largest joint-angle change (rad) and translation (mm).
+pub fn apply_step(
+    model: &Model,
+    q: &mut [f32],
+    delta: &SVector<f32, MAX_STATES>,
+    free: FreeMask,
+) -> (f32, f32) {
+    let (mut max_angle, mut max_move) = (0.0f32, 0.0f32);
+    for (i, v) in q.iter_mut().enumerate().take(MAX_STATES) {
+        if !free.contains(i) {
+            continue;
+        }
+        *v += delta[i];
+        if i >= BASE_STATES {
+            if let Some(limit) = model.limit(i) {
+                *v = v.clamp(limit.lo, limit.hi);
+            }
+            max_angle = max_angle.max(delta[i].abs());
+        } else if i >= 4 {
+            max_move = max_move.max(delta[i].abs());
+        } else {
+            max_angle = max_angle.max(delta[i].abs());
+        }
+    }
+    if q.len() >= 4 {
+        if let Some(u) = crate::quaternion::normalised([q[0], q[1], q[2], q[3]]) {
+            q[..4].copy_from_slice(&u);
+        }
+    }
+    (max_angle, max_move)
+}

@@ -1,1 +1,242 @@
-//! Slice features (Sec. 4.3.1). Placeholder until written.
+//! Slice features (Sec. 4.3.1): edges found along slices perpendicular to each projected link
+//! axis, and fingertips found by a search along the axis beyond the tip.
+//!
+//! Along a slice the 1-D intensity derivative is taken; a peak of the expected sign is a
+//! silhouette edge, located to sub-pixel precision by a parabola through the peak and its
+//! neighbours. The hand is expected brighter than what surrounds it (the derivative going
+//! outward is negative), except where the outside of an edge lies over a farther part of the
+//! hand, where either sign is accepted. Slices whose predicted edge lies inside a nearer link
+//! or the palm are masked ([`crate::visibility`]).
+
+use heapless::Vec;
+use nalgebra::Vector2;
+
+use crate::camera::Camera;
+use crate::config::{MAX_SLICES_PER_LINK, MAX_WINDOW};
+use crate::frame::FrameView;
+use crate::projection::ProjectedModel;
+use crate::visibility::{cover, Cover};
+
+/// Which sign of intensity change, going outward across an edge, counts as an edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Polarity {
+    /// Bright inside, dark outside (a hand over a darker background).
+    DarkOutside,
+    /// Either sign.
+    Any,
+}
+
+/// Parameters of the slice search.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub struct FeatureConfig {
+    /// Slices per link (at most [`MAX_SLICES_PER_LINK`]).
+    pub slices_per_link: u8,
+    /// Search window along each slice and beyond each tip (px, at most [`MAX_WINDOW`]).
+    pub window_px: u8,
+    /// Smallest derivative peak accepted as an edge (grey levels per px).
+    pub min_contrast: f32,
+    /// Slices are spread over this part of the axis (fractions of its length).
+    pub span: [f32; 2],
+    /// Links shorter than this in the image are skipped as seen end-on (px).
+    pub min_link_px: f32,
+    /// Sign of the edges sought.
+    pub polarity: Polarity,
+    /// Mask slices whose predicted edge is hidden by a nearer link or the palm.
+    pub mask_occluded: bool,
+    /// Search for fingertips.
+    pub tips: bool,
+}
+
+impl Default for FeatureConfig {
+    fn default() -> Self {
+        FeatureConfig {
+            slices_per_link: 5,
+            window_px: 20,
+            min_contrast: 4.0,
+            span: [0.15, 0.85],
+            min_link_px: 6.0,
+            polarity: Polarity::DarkOutside,
+            mask_occluded: true,
+            tips: true,
+        }
+    }
+}
+
+/// An edge found along a 1-D profile.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Edge {
+    /// Sub-pixel position, in samples from the profile's start.
+    pub position: f32,
+    /// Derivative magnitude at the peak (grey levels per sample).
+    pub strength: f32,
+}
+
+/// Finds the strongest edge of the wanted sign in `profile` (samples one pixel apart, going
+/// outward). The derivative is the smoothed difference `(2(I[k+1] − I[k−1]) + I[k+2] − I[k−2]) / 8`
+/// and the peak is refined by a parabola. `None` when no peak reaches `min_contrast`.
+pub fn find_edge(profile: &[f32], polarity: Polarity, min_contrast: f32) -> Option<Edge> {
+    let n = profile.len();
+    if n < 7 {
+        return None;
+    }
+    let mut derivative = [0.0f32; MAX_WINDOW];
+    let n = n.min(MAX_WINDOW);
+    for k in 2..n - 2 {
+        derivative[k] =
+            (2.0 * (profile[k + 1] - profile[k - 1]) + profile[k + 2] - profile[k - 2]) / 8.0;
+    }
+    let oriented = |v: f32| match polarity {
+        Polarity::DarkOutside => -v,
+        Polarity::Any => v.abs(),
+    };
+    let mut best: Option<(usize, f32)> = None;
+    for k in 3..n - 3 {
+        let v = oriented(derivative[k]);
+        if v >= min_contrast
+            && v >= oriented(derivative[k - 1])
+            && v > oriented(derivative[k + 1])
+            && best.is_none_or(|(_, b)| v > b)
+        {
+            best = Some((k, v));
+        }
+    }
+    let (k, strength) = best?;
+    let (l, c, r) = (
+        oriented(derivative[k - 1]),
+        strength,
+        oriented(derivative[k + 1]),
+    );
+    let curvature = l - 2.0 * c + r;
+    let offset = if curvature < -1e-6 {
+        (0.5 * (l - r) / curvature).clamp(-0.5, 0.5)
+    } else {
+        0.0
+    };
+    Some(Edge {
+        position: k as f32 + offset,
+        strength,
+    })
+}
+
+/// One silhouette edge point found on a slice.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct EdgePoint {
+    /// Where the slice crosses the axis, as a fraction of the axis from `a` to `b`.
+    pub s: f32,
+    /// Which side of the axis: +1 along the normal `(−d_y, d_x)` of the axis direction, or −1.
+    pub side: i8,
+    /// The edge in the image (px).
+    pub position: Vector2<f32>,
+    /// Derivative magnitude at the edge.
+    pub strength: f32,
+}
+
+/// Most edge points one link yields.
+pub const MAX_LINK_EDGES: usize = 2 * MAX_SLICES_PER_LINK;
+
+/// What the slice search found for one link.
+#[derive(Debug, Clone, Default)]
+pub struct LinkFeatures {
+    /// Silhouette edge points.
+    pub edges: Vec<EdgePoint, MAX_LINK_EDGES>,
+    /// The fingertip in the image (px), for a distal link.
+    pub tip: Option<Vector2<f32>>,
+    /// Edges and tips the model predicted visible and in the frame.
+    pub expected: u16,
+    /// Predicted edges and tips hidden by a nearer part of the hand.
+    pub masked: u16,
+    /// Slices and tip windows that left the frame.
+    pub off_frame: u16,
+}
+
+/// Unit axis direction and normal `(−d_y, d_x)` of a link in the image.
+pub fn axis_frame(a: &Vector2<f32>, b: &Vector2<f32>) -> (Vector2<f32>, Vector2<f32>) {
+    let d = b - a;
+    let len = d.norm();
+    let dir = if len > 1e-6 { d / len } else { Vector2::new(1.0, 0.0) };
+    (dir, Vector2::new(-dir.y, dir.x))
+}
+
+/// Runs the slice and tip searches for link `index` of `view` on `frame`, into `out`.
+pub fn find_link_features(
+    view: &ProjectedModel,
+    camera: &Camera,
+    frame: &FrameView<'_>,
+    index: usize,
+    config: &FeatureConfig,
+    out: &mut LinkFeatures,
+) {
+    out.edges.clear();
+    out.tip = None;
+    out.expected = 0;
+    out.masked = 0;
+    out.off_frame = 0;
+    let Some(link) = view.links.get(index) else {
+        return;
+    };
+    let window = usize::from(config.window_px).clamp(7, MAX_WINDOW);
+    let half = (window - 1) as f32 * 0.5;
+    let (dir, normal) = axis_frame(&link.a, &link.b);
+    let slices = usize::from(config.slices_per_link).clamp(1, MAX_SLICES_PER_LINK);
+    let mut profile = [0.0f32; MAX_WINDOW];
+    let mut search = |centre: Vector2<f32>, outward: Vector2<f32>, depth: f32, out: &mut LinkFeatures| {
+        let mut polarity = config.polarity;
+        if config.mask_occluded {
+            match cover(view, camera, index, &centre, depth) {
+                Cover::Hidden => {
+                    out.masked += 1;
+                    return None;
+                }
+                Cover::Behind => polarity = Polarity::Any,
+                Cover::Clear => {
+                    if cover(view, camera, index, &(centre + outward * 2.0), depth)
+                        != Cover::Clear
+                    {
+                        polarity = Polarity::Any;
+                    }
+                }
+            }
+        }
+        let start = centre - outward * half;
+        if !frame.sample_segment(start, outward, &mut profile[..window]) {
+            out.off_frame += 1;
+            return None;
+        }
+        out.expected += 1;
+        let edge = find_edge(&profile[..window], polarity, config.min_contrast)?;
+        Some((start + outward * edge.position, edge.strength))
+    };
+    for k in 0..slices {
+        let s = if slices == 1 {
+            0.5 * (config.span[0] + config.span[1])
+        } else {
+            config.span[0] + (config.span[1] - config.span[0]) * k as f32 / (slices - 1) as f32
+        };
+        let axis_point = link.a + (link.b - link.a) * s;
+        let radius = link.radius_at(s);
+        let depth = link.depth_at(s);
+        for side in [1i8, -1] {
+            let outward = normal * f32::from(side);
+            let predicted = axis_point + outward * radius;
+            if let Some((position, strength)) = search(predicted, outward, depth, out) {
+                let _ = out.edges.push(EdgePoint {
+                    s,
+                    side,
+                    position,
+                    strength,
+                });
+            }
+        }
+    }
+    if config.tips && link.distal {
+        let predicted = link.b + dir * link.r1;
+        if let Some((position, _)) = search(predicted, dir, link.z1, out) {
+            out.tip = Some(position);
+        }
+    }
+}

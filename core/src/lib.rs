@@ -31,7 +31,10 @@ pub mod features;
 pub mod frame;
 pub mod kinematics;
 pub mod model;
+pub mod projection;
+pub mod model_writer;
 pub mod quaternion;
 pub mod tracker;
+pub mod visibility;
 
 pub use nalgebra;

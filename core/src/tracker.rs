@@ -1,4 +1,9 @@
-//! The per-frame tracking loop (Sec. 4.3.2) and its report. (API stub; being written.)
+//! The per-frame tracking loop (Sec. 4.3.2) and its report.
+//!
+//! For each frame: optionally predict the start state by constant velocity, then `iterations`
+//! times — pose the links, project them into every camera, find slice features again, add the
+//! residual rows of every camera to one set of normal equations (Sec. 2.5.5), take the
+//! conditioned Gauss–Newton step.
 
 use core::fmt;
 
@@ -6,25 +11,49 @@ use heapless::Vec;
 
 use crate::camera::{Camera, CameraError};
 use crate::config::{MAX_CAMERAS, MAX_STATES};
+use crate::estimator::{
+    add_link_rows, apply_step, EstimatorConfig, FreeMask, LinkJacobian, NormalEquations,
+};
+use crate::features::{find_link_features, FeatureConfig, LinkFeatures};
 use crate::frame::{FrameError, FrameView};
-use crate::kinematics::KinematicsError;
+use crate::kinematics::{KinematicsError, Poses};
 use crate::model::Model;
+use crate::projection::ProjectedModel;
 
 /// Tracker parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub struct TrackerConfig {
-    /// Gauss–Newton iterations per frame; features are found again at every one.
+    /// Gauss–Newton iterations per frame at most; features are found again at every one.
     pub iterations: u8,
-    /// Predict each frame's start state by constant velocity from the last two.
+    /// Predict each frame's start state by constant velocity from the last two frames.
     pub predict: bool,
+    /// Stop iterating once no joint or quaternion state moves more than this (rad).
+    pub converged_rad: f32,
+    /// ... and no translation state more than this (mm).
+    pub converged_mm: f32,
+    /// The frame is `lost` when fewer than this fraction of expected features were found.
+    pub lost_min_found: f32,
+    /// The frame is `lost` when the residual RMS exceeds this (px).
+    pub lost_rms_px: f32,
+    /// Slice search parameters.
+    pub features: FeatureConfig,
+    /// Residual and solve parameters.
+    pub estimator: EstimatorConfig,
 }
 
 impl Default for TrackerConfig {
     fn default() -> Self {
         TrackerConfig {
-            iterations: 6,
+            iterations: 8,
             predict: true,
+            converged_rad: 2e-4,
+            converged_mm: 5e-3,
+            lost_min_found: 0.3,
+            lost_rms_px: 6.0,
+            features: FeatureConfig::default(),
+            estimator: EstimatorConfig::default(),
         }
     }
 }
@@ -33,12 +62,16 @@ impl Default for TrackerConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FrameReport {
-    /// Root-mean-square image residual after the last iteration (px).
+    /// Root-mean-square image residual of the last iteration (px).
     pub rms_px: f32,
     /// Features found in the last iteration (edge points and tips).
     pub features_found: u16,
-    /// Features the model predicted should be visible in the last iteration.
+    /// Features the model predicted visible and in the frame in the last iteration.
     pub features_expected: u16,
+    /// Predicted features masked as hidden by a nearer part of the hand (last iteration).
+    pub features_masked: u16,
+    /// Links skipped in the last iteration (end-on, off-frame or behind a camera).
+    pub links_skipped: u16,
     /// Iterations run.
     pub iterations: u8,
     /// Too few features, or the residual exploded: the state is not to be trusted.
@@ -79,18 +112,32 @@ impl fmt::Display for TrackerError {
 
 impl core::error::Error for TrackerError {}
 
+/// Working memory of one iteration, kept between frames so nothing is allocated per frame.
+#[derive(Debug, Clone)]
+struct Workspace {
+    poses: Poses,
+    views: [ProjectedModel; MAX_CAMERAS],
+    features: LinkFeatures,
+    jacobian: LinkJacobian,
+    normal: NormalEquations,
+}
+
 /// Tracks one hand over frames from one or more calibrated cameras.
 #[derive(Debug, Clone)]
 pub struct Tracker {
     model: Model,
     cameras: Vec<Camera, MAX_CAMERAS>,
     state: Vec<f32, MAX_STATES>,
+    previous: Option<Vec<f32, MAX_STATES>>,
+    free: FreeMask,
     config: TrackerConfig,
+    work: Workspace,
 }
 
 impl Tracker {
-    /// A tracker starting from `initial` (one value per model state), estimating the states
-    /// listed in `free` (all when `None`).
+    /// A tracker starting from `initial` (one value per model state: quaternion, mm, rad),
+    /// estimating the states listed in `free` (all when `None`). Naming any quaternion state
+    /// frees all four.
     pub fn new(
         model: Model,
         cameras: &[Camera],
@@ -98,26 +145,64 @@ impl Tracker {
         free: Option<&[u8]>,
         config: TrackerConfig,
     ) -> Result<Self, TrackerError> {
-        let _ = free;
-        let cameras = Vec::from_slice(cameras).map_err(|_| TrackerError::CameraCount)?;
-        let state = Vec::from_slice(initial).map_err(|_| {
-            TrackerError::State(KinematicsError::WrongStateCount {
-                expected: model.n_states() as u8,
-                got: 255,
-            })
-        })?;
-        Ok(Tracker {
+        if cameras.is_empty() {
+            return Err(TrackerError::CameraCount);
+        }
+        let cameras: Vec<Camera, MAX_CAMERAS> =
+            Vec::from_slice(cameras).map_err(|_| TrackerError::CameraCount)?;
+        for c in &cameras {
+            c.validate().map_err(TrackerError::Camera)?;
+        }
+        let n = model.n_states();
+        let mask = match free {
+            None => FreeMask::all(n),
+            Some(list) => {
+                let mut m = 0u32;
+                for &s in list {
+                    if usize::from(s) >= n {
+                        return Err(TrackerError::BadFreeState(s));
+                    }
+                    m |= 1 << s;
+                }
+                if m & 0b1111 != 0 {
+                    m |= 0b1111;
+                }
+                FreeMask(m)
+            }
+        };
+        let poses = Poses::compute(&model, initial).map_err(TrackerError::State)?;
+        let mut tracker = Tracker {
             model,
             cameras,
-            state,
+            state: Vec::new(),
+            previous: None,
+            free: mask,
             config,
-        })
+            work: Workspace {
+                poses,
+                views: Default::default(),
+                features: LinkFeatures::default(),
+                jacobian: LinkJacobian::default(),
+                normal: NormalEquations::new(),
+            },
+        };
+        tracker.reset(initial)?;
+        Ok(tracker)
     }
 
-    /// Tracks one instant: `frames[i]` is camera `i`'s frame. Updates and returns the state.
-    pub fn track(&mut self, frames: &[FrameView<'_>]) -> Result<FrameReport, TrackerError> {
-        let _ = (frames, &self.cameras, self.config);
-        Ok(FrameReport::default())
+    /// Restarts tracking from `state`, forgetting the motion so far.
+    pub fn reset(&mut self, state: &[f32]) -> Result<(), TrackerError> {
+        self.work
+            .poses
+            .update(&self.model, state)
+            .map_err(TrackerError::State)?;
+        self.state.clear();
+        let _ = self.state.extend_from_slice(state);
+        if let Some(u) = crate::quaternion::normalised([state[0], state[1], state[2], state[3]]) {
+            self.state[..4].copy_from_slice(&u);
+        }
+        self.previous = None;
+        Ok(())
     }
 
     /// The current state estimate (quaternion, mm, rad).
@@ -128,5 +213,143 @@ impl Tracker {
     /// The model tracked.
     pub fn model(&self) -> &Model {
         &self.model
+    }
+
+    /// The cameras, in the order frames are given to [`Tracker::track`].
+    pub fn cameras(&self) -> &[Camera] {
+        &self.cameras
+    }
+
+    /// The states being estimated.
+    pub fn free(&self) -> FreeMask {
+        self.free
+    }
+
+    /// The parameters in use.
+    pub fn config(&self) -> &TrackerConfig {
+        &self.config
+    }
+
+    /// Tracks one instant: `frames[i]` is camera `i`'s frame. Updates the state and reports.
+    /// A frame of the wrong size is an error and leaves the state unchanged.
+    pub fn track(&mut self, frames: &[FrameView<'_>]) -> Result<FrameReport, TrackerError> {
+        if frames.len() != self.cameras.len() {
+            return Err(TrackerError::FrameCount);
+        }
+        for (f, c) in frames.iter().zip(self.cameras.iter()) {
+            if f.width() != c.width as usize || f.height() != c.height as usize {
+                return Err(TrackerError::Frame(FrameError::WrongSize {
+                    expected_width: c.width,
+                    expected_height: c.height,
+                }));
+            }
+        }
+        let start = self.state.clone();
+        let mut q = self.predicted();
+        let mut report = FrameReport::default();
+        for _ in 0..self.config.iterations.max(1) {
+            let Some(step) = self.iterate(&q, frames, &mut report) else {
+                report.lost = true;
+                break;
+            };
+            report.iterations += 1;
+            let (angle, moved) = apply_step(&self.model, &mut q, &step, self.free);
+            if angle < self.config.converged_rad && moved < self.config.converged_mm {
+                break;
+            }
+        }
+        let found = f32::from(report.features_found);
+        let expected = f32::from(report.features_expected).max(1.0);
+        report.lost |= found < self.config.lost_min_found * expected
+            || report.rms_px > self.config.lost_rms_px;
+        if q.iter().all(|v| v.is_finite()) {
+            self.previous = Some(start);
+            self.state = q;
+        } else {
+            report.lost = true;
+        }
+        Ok(report)
+    }
+
+    /// The start state of a frame: constant-velocity extrapolation of the free states.
+    fn predicted(&self) -> Vec<f32, MAX_STATES> {
+        let mut q = self.state.clone();
+        if let (true, Some(prev)) = (self.config.predict, &self.previous) {
+            for (i, v) in q.iter_mut().enumerate() {
+                if self.free.contains(i) {
+                    *v += *v - prev[i];
+                    if let Some(limit) = self.model.limit(i) {
+                        *v = v.clamp(limit.lo, limit.hi);
+                    }
+                }
+            }
+            if let Some(u) = crate::quaternion::normalised([q[0], q[1], q[2], q[3]]) {
+                q[..4].copy_from_slice(&u);
+            }
+        }
+        q
+    }
+
+    /// One Gauss–Newton iteration at `q`: the step, or `None` when no step can be taken.
+    fn iterate(
+        &mut self,
+        q: &[f32],
+        frames: &[FrameView<'_>],
+        report: &mut FrameReport,
+    ) -> Option<nalgebra::SVector<f32, MAX_STATES>> {
+        let work = &mut self.work;
+        work.poses.update(&self.model, q).ok()?;
+        work.normal.clear();
+        report.features_found = 0;
+        report.features_expected = 0;
+        report.features_masked = 0;
+        report.links_skipped = 0;
+        let config = &self.config;
+        for ((camera, frame), view) in self
+            .cameras
+            .iter()
+            .zip(frames.iter())
+            .zip(work.views.iter_mut())
+        {
+            view.update(&self.model, &work.poses, camera, config.features.min_link_px);
+            let skipped = view.skipped;
+            report.links_skipped += skipped.behind + skipped.end_on + skipped.off_frame;
+            for index in 0..view.links.len() {
+                find_link_features(
+                    view,
+                    camera,
+                    frame,
+                    index,
+                    &config.features,
+                    &mut work.features,
+                );
+                let found = work.features.edges.len() as u16 + u16::from(work.features.tip.is_some());
+                report.features_found += found;
+                report.features_expected += work.features.expected;
+                report.features_masked += work.features.masked;
+                if found == 0 {
+                    continue;
+                }
+                let link = &view.links[index];
+                work.jacobian.compute(&self.model, &work.poses, camera, link);
+                add_link_rows(
+                    &mut work.normal,
+                    link,
+                    &work.features,
+                    &work.jacobian,
+                    &config.estimator,
+                    self.free,
+                );
+            }
+        }
+        report.rms_px = work.normal.rms();
+        if work.normal.rows() == 0 {
+            return None;
+        }
+        work.normal.step(
+            self.model.n_states(),
+            self.free,
+            &config.estimator.conditioning,
+        )
     }
 }

@@ -1,0 +1,286 @@
+//! The model seen by one camera: every capsule link's axis and radius in the image, and the
+//! palm, with depths for visibility reasoning.
+
+use heapless::Vec;
+use nalgebra::{Matrix3, Vector2, Vector3};
+
+use crate::camera::Camera;
+use crate::config::MAX_FRAMES;
+use crate::kinematics::Poses;
+use crate::model::{Model, Shape};
+
+/// An axis-aligned box in the image (px).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bounds {
+    /// Smallest corner (px).
+    pub min: Vector2<f32>,
+    /// Largest corner (px).
+    pub max: Vector2<f32>,
+}
+
+impl Bounds {
+    /// Whether `p` lies inside.
+    pub fn contains(&self, p: &Vector2<f32>) -> bool {
+        p.x >= self.min.x && p.y >= self.min.y && p.x <= self.max.x && p.y <= self.max.y
+    }
+
+    fn around(a: Vector2<f32>, b: Vector2<f32>, pad: f32) -> Bounds {
+        Bounds {
+            min: Vector2::new(a.x.min(b.x) - pad, a.y.min(b.y) - pad),
+            max: Vector2::new(a.x.max(b.x) + pad, a.y.max(b.y) + pad),
+        }
+    }
+}
+
+/// One capsule link in the image.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProjectedLink {
+    /// The link's frame (its capsule axis starts at this frame's origin).
+    pub frame: u8,
+    /// The frame where the axis ends.
+    pub child: u8,
+    /// Whether the child is a fingertip (a tip search runs beyond `b`).
+    pub distal: bool,
+    /// Capsule radius (mm).
+    pub radius_mm: f32,
+    /// Axis start and end in the world (mm).
+    pub p0: Vector3<f32>,
+    /// Axis end in the world (mm).
+    pub p1: Vector3<f32>,
+    /// Axis start in the image (px).
+    pub a: Vector2<f32>,
+    /// Axis end in the image (px).
+    pub b: Vector2<f32>,
+    /// Camera depth of the axis start and end (mm).
+    pub z0: f32,
+    /// Camera depth of the axis end (mm).
+    pub z1: f32,
+    /// Projected radius at the axis start and end (px).
+    pub r0: f32,
+    /// Projected radius at the axis end (px).
+    pub r1: f32,
+    /// Image bounds of the whole capsule (px).
+    pub bounds: Bounds,
+}
+
+impl ProjectedLink {
+    /// Image length of the axis (px).
+    pub fn length(&self) -> f32 {
+        (self.b - self.a).norm()
+    }
+
+    /// Closest axis parameter `s ∈ [0, 1]` to image point `p`, and the distance (px).
+    pub fn closest(&self, p: &Vector2<f32>) -> (f32, f32) {
+        let d = self.b - self.a;
+        let len2 = d.norm_squared();
+        let s = if len2 > 1e-9 {
+            ((p - self.a).dot(&d) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (s, (self.a + d * s - p).norm())
+    }
+
+    /// Projected radius at axis parameter `s` (px).
+    pub fn radius_at(&self, s: f32) -> f32 {
+        self.r0 + (self.r1 - self.r0) * s
+    }
+
+    /// Camera depth of the axis at parameter `s` (mm).
+    pub fn depth_at(&self, s: f32) -> f32 {
+        self.z0 + (self.z1 - self.z0) * s
+    }
+}
+
+/// The palm box as one camera sees it, for exact ray tests.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProjectedPalm {
+    /// Image bounds of the box's corners (px).
+    pub bounds: Bounds,
+    /// Camera centre in the palm frame (mm).
+    origin: Vector3<f32>,
+    /// Maps a camera ray `((u−cx)/fx, (v−cy)/fy, 1)` to a direction in the palm frame.
+    to_palm: Matrix3<f32>,
+    lo: Vector3<f32>,
+    hi: Vector3<f32>,
+}
+
+impl ProjectedPalm {
+    /// Camera depth (mm) at which the ray through pixel `p` enters the palm box, if it does.
+    pub fn depth_at(&self, camera: &Camera, p: &Vector2<f32>) -> Option<f32> {
+        if !self.bounds.contains(p) {
+            return None;
+        }
+        let ray = Vector3::new((p.x - camera.cx) / camera.fx, (p.y - camera.cy) / camera.fy, 1.0);
+        let dir = self.to_palm * ray;
+        let (mut t_in, mut t_out) = (0.0f32, f32::INFINITY);
+        for k in 0..3 {
+            if dir[k].abs() < 1e-12 {
+                if self.origin[k] < self.lo[k] || self.origin[k] > self.hi[k] {
+                    return None;
+                }
+                continue;
+            }
+            let t1 = (self.lo[k] - self.origin[k]) / dir[k];
+            let t2 = (self.hi[k] - self.origin[k]) / dir[k];
+            t_in = t_in.max(t1.min(t2));
+            t_out = t_out.min(t1.max(t2));
+        }
+        (t_in <= t_out).then_some(t_in)
+    }
+}
+
+/// Why a link was left out of one camera's view.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SkipCounts {
+    /// Links with an end behind or at the camera.
+    pub behind: u16,
+    /// Links whose axis is shorter than the minimum in the image (seen end-on).
+    pub end_on: u16,
+    /// Links wholly outside the frame.
+    pub off_frame: u16,
+}
+
+/// Every capsule link and the palm as one camera sees them.
+#[derive(Debug, Clone)]
+pub struct ProjectedModel {
+    /// Links in view, in table order.
+    pub links: Vec<ProjectedLink, MAX_FRAMES>,
+    /// The palm box, when the model has one in view.
+    pub palm: Option<ProjectedPalm>,
+    /// Links left out, and why.
+    pub skipped: SkipCounts,
+}
+
+impl ProjectedModel {
+    /// An empty projection.
+    pub const fn new() -> Self {
+        ProjectedModel {
+            links: Vec::new(),
+            palm: None,
+            skipped: SkipCounts {
+                behind: 0,
+                end_on: 0,
+                off_frame: 0,
+            },
+        }
+    }
+
+    /// Projects every capsule link and the palm of `model` at `poses` into `camera`.
+    /// Links shorter than `min_length_px` in the image are skipped as end-on.
+    pub fn update(&mut self, model: &Model, poses: &Poses, camera: &Camera, min_length_px: f32) {
+        self.links.clear();
+        self.palm = None;
+        self.skipped = SkipCounts::default();
+        let frame_bounds = Bounds {
+            min: Vector2::new(0.0, 0.0),
+            max: Vector2::new(camera.width as f32 - 1.0, camera.height as f32 - 1.0),
+        };
+        for (i, link) in model.links().iter().enumerate() {
+            match link.shape {
+                Shape::Cylinder { radius } => {
+                    let Some(&child) = link.children.first() else { continue };
+                    let (Some(p0), Some(p1)) = (poses.origin(i), poses.origin(usize::from(child)))
+                    else {
+                        continue;
+                    };
+                    let (Some(a), Some(b)) = (camera.project(&p0), camera.project(&p1)) else {
+                        self.skipped.behind += 1;
+                        continue;
+                    };
+                    let z0 = camera.to_camera(&p0).z;
+                    let z1 = camera.to_camera(&p1).z;
+                    let r0 = camera.pixels_at_depth(radius, z0);
+                    let r1 = camera.pixels_at_depth(radius, z1);
+                    let bounds = Bounds::around(a, b, r0.max(r1));
+                    if !overlaps(&bounds, &frame_bounds) {
+                        self.skipped.off_frame += 1;
+                        continue;
+                    }
+                    if (b - a).norm() < min_length_px {
+                        self.skipped.end_on += 1;
+                        continue;
+                    }
+                    let distal = model
+                        .links()
+                        .get(usize::from(child))
+                        .is_some_and(|c| matches!(c.shape, Shape::Tip { .. }));
+                    let _ = self.links.push(ProjectedLink {
+                        frame: i as u8,
+                        child,
+                        distal,
+                        radius_mm: radius,
+                        p0,
+                        p1,
+                        a,
+                        b,
+                        z0,
+                        z1,
+                        r0,
+                        r1,
+                        bounds,
+                    });
+                }
+                Shape::Box { size, centre } => {
+                    if let Some(pose) = poses.frame(i) {
+                        self.palm = project_box(camera, pose.r, pose.t, size, centre);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// Whether links `i` and `j` (indices into `links`) share a joint.
+    pub fn adjacent(&self, i: usize, j: usize) -> bool {
+        match (self.links.get(i), self.links.get(j)) {
+            (Some(a), Some(b)) => a.child == b.frame || b.child == a.frame,
+            _ => false,
+        }
+    }
+}
+
+impl Default for ProjectedModel {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+fn overlaps(a: &Bounds, b: &Bounds) -> bool {
+    a.min.x <= b.max.x && a.max.x >= b.min.x && a.min.y <= b.max.y && a.max.y >= b.min.y
+}
+
+fn project_box(
+    camera: &Camera,
+    r: Matrix3<f32>,
+    t: Vector3<f32>,
+    size: [f32; 3],
+    centre: [f32; 3],
+) -> Option<ProjectedPalm> {
+    let half = Vector3::new(size[0], size[1], size[2]) * 0.5;
+    let c = Vector3::new(centre[0], centre[1], centre[2]);
+    let (lo, hi) = (c - half, c + half);
+    let mut bounds = Bounds {
+        min: Vector2::new(f32::INFINITY, f32::INFINITY),
+        max: Vector2::new(f32::NEG_INFINITY, f32::NEG_INFINITY),
+    };
+    for corner in 0..8 {
+        let local = Vector3::new(
+            if corner & 1 == 0 { lo.x } else { hi.x },
+            if corner & 2 == 0 { lo.y } else { hi.y },
+            if corner & 4 == 0 { lo.z } else { hi.z },
+        );
+        let uv = camera.project(&(r * local + t))?;
+        bounds.min = bounds.min.inf(&uv);
+        bounds.max = bounds.max.sup(&uv);
+    }
+    let rt = r.transpose();
+    Some(ProjectedPalm {
+        bounds,
+        origin: rt * (camera.centre() - t),
+        to_palm: rt * camera.r.transpose(),
+        lo,
+        hi,
+    })
+}
