@@ -16,7 +16,7 @@ use nalgebra::{SMatrix, SVector, Vector2};
 
 use crate::camera::Camera;
 use crate::config::{MAX_ROW_NONZEROS, MAX_STATES};
-use crate::features::{axis_frame, LinkFeatures};
+use crate::features::{axis_frame, EdgePoint, LinkFeatures};
 use crate::kinematics::Poses;
 use crate::model::{Model, BASE_STATES};
 use crate::projection::ProjectedLink;
@@ -186,8 +186,8 @@ impl LinkJacobian {
             let _ = self.states.push(*s);
             let _ = self.da.push(j0 * v0);
             let _ = self.db.push(j1 * v1);
-            let _ = self.dr0.push(-link.r0 / z0 * (depth_row * v0)[0]);
-            let _ = self.dr1.push(-link.r1 / z1 * (depth_row * v1)[0]);
+            let _ = self.dr0.push(-link.radius_at(0.0) / z0 * (depth_row * v0)[0]);
+            let _ = self.dr1.push(-link.radius_at(1.0) / z1 * (depth_row * v1)[0]);
         }
     }
 }
@@ -294,8 +294,8 @@ impl NormalEquations {
     }
 }
 
-/// A row of derivative entries.
-type Row = Vec<(u8, f32), MAX_ROW_NONZEROS>;
+/// A row of derivative entries `(state, ∂r/∂q_state)`.
+pub type Row = Vec<(u8, f32), MAX_ROW_NONZEROS>;
 
 /// What one link contributed to the normal equations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -319,36 +319,19 @@ pub fn add_link_rows(
     if jac.states.is_empty() {
         return added;
     }
-    let (dir, normal) = axis_frame(&link.a, &link.b);
-    let axis = link.b - link.a;
-    let len2 = axis.norm_squared().max(1e-9);
     let mut row = Row::new();
     match config.residual {
         ResidualKind::EdgePoints => {
             for e in &features.edges {
-                let side = f32::from(e.side);
-                let s = ((e.position - link.a).dot(&axis) / len2).clamp(0.0, 1.0);
-                let measured = side * normal.dot(&(e.position - link.a));
-                let r = link.radius_at(s) - measured;
-                row.clear();
-                for k in 0..jac.states.len() {
-                    let moved = jac.da[k] * (1.0 - s) + jac.db[k] * s;
-                    let dr = jac.dr0[k] * (1.0 - s) + jac.dr1[k] * s;
-                    let _ = row.push((jac.states[k], side * normal.dot(&moved) + dr));
-                }
+                let r = edge_row(link, jac, e, &mut row);
                 ne.add_row(&row, r, config.robust.weight(r), free);
                 added.edges += 1;
             }
         }
         ResidualKind::AxisLines => {
-            if let Some((centre, line_normal)) = fit_axis_line(link, features) {
-                for (point, end) in [(link.a, 0usize), (link.b, 1)] {
-                    let r = line_normal.dot(&(point - centre));
-                    row.clear();
-                    for k in 0..jac.states.len() {
-                        let moved = if end == 0 { jac.da[k] } else { jac.db[k] };
-                        let _ = row.push((jac.states[k], line_normal.dot(&moved)));
-                    }
+            if let Some(line) = fit_axis_line(link, features) {
+                for end in [0, 1] {
+                    let r = line_row(link, jac, line, end, &mut row);
                     ne.add_row(&row, r, 1.0, free);
                     added.edges += 1;
                 }
@@ -356,15 +339,66 @@ pub fn add_link_rows(
         }
     }
     if let Some(tip) = features.tip {
-        let r = dir.dot(&(link.b - tip)) + link.r1;
-        row.clear();
-        for k in 0..jac.states.len() {
-            let _ = row.push((jac.states[k], dir.dot(&jac.db[k]) + jac.dr1[k]));
-        }
+        let r = tip_row(link, jac, &tip, &mut row);
         ne.add_row(&row, r, config.tip_weight * config.robust.weight(r), free);
         added.tips += 1;
     }
     added
+}
+
+/// The edge-point residual of `edge` (px): the predicted silhouette offset minus the measured
+/// one, at the edge's foot on the axis. Positive when the edge lies inside the prediction.
+pub fn edge_residual(link: &ProjectedLink, edge: &EdgePoint) -> f32 {
+    let (_, normal) = axis_frame(&link.a, &link.b);
+    let axis = link.b - link.a;
+    let s = ((edge.position - link.a).dot(&axis) / axis.norm_squared().max(1e-9)).clamp(0.0, 1.0);
+    link.side_radius_at(s, edge.side) - f32::from(edge.side) * normal.dot(&(edge.position - link.a))
+}
+
+/// The edge-point residual (px) and its derivative row (into `row`), from the derivative of a
+/// fixed point's distance to a moving line: `σ n·((1−s) ∂a + s ∂b) + ∂r(s)`.
+pub fn edge_row(link: &ProjectedLink, jac: &LinkJacobian, edge: &EdgePoint, row: &mut Row) -> f32 {
+    let (_, normal) = axis_frame(&link.a, &link.b);
+    let axis = link.b - link.a;
+    let s = ((edge.position - link.a).dot(&axis) / axis.norm_squared().max(1e-9)).clamp(0.0, 1.0);
+    let side = f32::from(edge.side);
+    row.clear();
+    for k in 0..jac.states.len() {
+        let moved = jac.da[k] * (1.0 - s) + jac.db[k] * s;
+        let dr = jac.dr0[k] * (1.0 - s) + jac.dr1[k] * s;
+        let _ = row.push((jac.states[k], side * normal.dot(&moved) + dr));
+    }
+    edge_residual(link, edge)
+}
+
+/// The axis-line residual (Eq. 2.17) of the model axis' start (`end` 0) or end (`end` 1)
+/// against the measured line `(point, normal)` (px), and its derivative row.
+pub fn line_row(
+    link: &ProjectedLink,
+    jac: &LinkJacobian,
+    line: (Vector2<f32>, Vector2<f32>),
+    end: usize,
+    row: &mut Row,
+) -> f32 {
+    let (centre, line_normal) = line;
+    let point = if end == 0 { link.a } else { link.b };
+    row.clear();
+    for k in 0..jac.states.len() {
+        let moved = if end == 0 { jac.da[k] } else { jac.db[k] };
+        let _ = row.push((jac.states[k], line_normal.dot(&moved)));
+    }
+    line_normal.dot(&(point - centre))
+}
+
+/// The tip residual (Eq. 2.19, along the image axis) of a fingertip found at `tip` (px):
+/// predicted minus measured distance beyond `b`, and its derivative row.
+pub fn tip_row(link: &ProjectedLink, jac: &LinkJacobian, tip: &Vector2<f32>, row: &mut Row) -> f32 {
+    let (dir, _) = axis_frame(&link.a, &link.b);
+    row.clear();
+    for k in 0..jac.states.len() {
+        let _ = row.push((jac.states[k], dir.dot(&jac.db[k]) + jac.dr1[k]));
+    }
+    dir.dot(&(link.b - tip)) + link.tip_offset
 }
 
 /// Fits the axis line of a link through its edge points, each moved toward the axis by the
@@ -380,7 +414,7 @@ pub fn fit_axis_line(
     let mut points: Vec<Vector2<f32>, { crate::features::MAX_LINK_EDGES }> = Vec::new();
     for e in &features.edges {
         let s = ((e.position - link.a).dot(&axis) / len2).clamp(0.0, 1.0);
-        let _ = points.push(e.position - normal * (f32::from(e.side) * link.radius_at(s)));
+        let _ = points.push(e.position - normal * (f32::from(e.side) * link.side_radius_at(s, e.side)));
     }
     let first = total_least_squares(&points, None)?;
     let mut deviations: Vec<f32, { crate::features::MAX_LINK_EDGES }> = Vec::new();

@@ -56,7 +56,7 @@ impl Default for FeatureConfig {
             slices_per_link: 5,
             window_px: 20,
             min_contrast: 4.0,
-            span: [0.15, 0.85],
+            span: [0.3, 0.8],
             min_link_px: 6.0,
             polarity: Polarity::DarkOutside,
             mask_occluded: true,
@@ -112,6 +112,46 @@ pub fn find_edge(profile: &[f32], polarity: Polarity, min_contrast: f32) -> Opti
     );
     let curvature = l - 2.0 * c + r;
     let offset = if curvature < -1e-6 {
+        (0.5 * (l - r) / curvature).clamp(-0.5, 0.5)
+    } else {
+        0.0
+    };
+    Some(Edge {
+        position: k as f32 + offset,
+        strength,
+    })
+}
+
+/// Finds the boundary between two touching bright surfaces in `profile`: the deepest intensity
+/// valley (smoothed `[1 2 1] / 4`) at least `min_depth` below the brightest sample on each side,
+/// refined by a parabola. Under shading, where one part of the hand lies over another, the
+/// silhouette is this valley, while the steepest descent lies on the shading ramp inside it.
+pub fn find_valley(profile: &[f32], min_depth: f32) -> Option<Edge> {
+    let n = profile.len().min(MAX_WINDOW);
+    if n < 5 {
+        return None;
+    }
+    let mut smooth = [0.0f32; MAX_WINDOW];
+    for k in 1..n - 1 {
+        smooth[k] = 0.25 * (profile[k - 1] + 2.0 * profile[k] + profile[k + 1]);
+    }
+    let mut best: Option<(usize, f32)> = None;
+    for k in 2..n - 2 {
+        let v = smooth[k];
+        if v > smooth[k - 1] || v > smooth[k + 1] {
+            continue;
+        }
+        let left = smooth[1..k].iter().fold(f32::MIN, |m, x| m.max(*x));
+        let right = smooth[k + 1..n - 1].iter().fold(f32::MIN, |m, x| m.max(*x));
+        let depth = (left - v).min(right - v);
+        if depth >= min_depth && best.is_none_or(|(_, d)| depth > d) {
+            best = Some((k, depth));
+        }
+    }
+    let (k, strength) = best?;
+    let (l, c, r) = (smooth[k - 1], smooth[k], smooth[k + 1]);
+    let curvature = l - 2.0 * c + r;
+    let offset = if curvature > 1e-6 {
         (0.5 * (l - r) / curvature).clamp(-0.5, 0.5)
     } else {
         0.0
@@ -185,20 +225,17 @@ pub fn find_link_features(
     let slices = usize::from(config.slices_per_link).clamp(1, MAX_SLICES_PER_LINK);
     let mut profile = [0.0f32; MAX_WINDOW];
     let mut search = |centre: Vector2<f32>, outward: Vector2<f32>, depth: f32, out: &mut LinkFeatures| {
-        let mut polarity = config.polarity;
+        let mut over_hand = false;
         if config.mask_occluded {
             match cover(view, camera, index, &centre, depth) {
                 Cover::Hidden => {
                     out.masked += 1;
                     return None;
                 }
-                Cover::Behind => polarity = Polarity::Any,
+                Cover::Behind => over_hand = true,
                 Cover::Clear => {
-                    if cover(view, camera, index, &(centre + outward * 2.0), depth)
-                        != Cover::Clear
-                    {
-                        polarity = Polarity::Any;
-                    }
+                    over_hand = cover(view, camera, index, &(centre + outward * 2.0), depth)
+                        != Cover::Clear;
                 }
             }
         }
@@ -208,7 +245,12 @@ pub fn find_link_features(
             return None;
         }
         out.expected += 1;
-        let edge = find_edge(&profile[..window], polarity, config.min_contrast)?;
+        let edge = if over_hand {
+            find_valley(&profile[..window], config.min_contrast)
+                .or_else(|| find_edge(&profile[..window], Polarity::Any, config.min_contrast))?
+        } else {
+            find_edge(&profile[..window], config.polarity, config.min_contrast)?
+        };
         Some((start + outward * edge.position, edge.strength))
     };
     for k in 0..slices {
@@ -218,11 +260,10 @@ pub fn find_link_features(
             config.span[0] + (config.span[1] - config.span[0]) * k as f32 / (slices - 1) as f32
         };
         let axis_point = link.a + (link.b - link.a) * s;
-        let radius = link.radius_at(s);
         let depth = link.depth_at(s);
         for side in [1i8, -1] {
             let outward = normal * f32::from(side);
-            let predicted = axis_point + outward * radius;
+            let predicted = axis_point + outward * link.side_radius_at(s, side);
             if let Some((position, strength)) = search(predicted, outward, depth, out) {
                 let _ = out.edges.push(EdgePoint {
                     s,
@@ -234,7 +275,7 @@ pub fn find_link_features(
         }
     }
     if config.tips && link.distal {
-        let predicted = link.b + dir * link.r1;
+        let predicted = link.b + dir * link.tip_offset;
         if let Some((position, _)) = search(predicted, dir, link.z1, out) {
             out.tip = Some(position);
         }

@@ -4,7 +4,8 @@
 //! Two things make the round trip exact:
 //! - numbers are written with `f32`'s `Display`, which prints the shortest decimal that parses
 //!   back to the same `f32` (never an exponent, so the parser's `[-]A[*B][/C]` grammar reads
-//!   it);
+//!   it); angles that are exactly what the parser makes of `pi/2`, `-pi`, `2*pi/3`, ... are
+//!   written that way, as in the published table;
 //! - every frame row is written on the source line it was parsed from ([`Link::line`], part of
 //!   the model's equality), padding with a header comment and blank lines; `limit` rows follow
 //!   the last frame.
@@ -54,7 +55,7 @@ fn write_row<W: Write>(index: usize, link: &Link, out: &mut W) -> fmt::Result {
         ThetaText(link.theta),
         link.d,
         link.a,
-        link.alpha
+        Angle(link.alpha)
     )?;
     match link.shape {
         Shape::None => write!(out, "{:<16} ", "-")?,
@@ -88,7 +89,7 @@ impl fmt::Display for ThetaText {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.0 {
             Theta::Base => f.pad("base"),
-            Theta::Const(v) => fmt::Display::fmt(&v, f),
+            Theta::Const(v) => fmt::Display::fmt(&Angle(v), f),
             Theta::State(s) => {
                 // "q" + at most 3 digits.
                 let mut text: heapless::String<4> = heapless::String::new();
@@ -96,5 +97,42 @@ impl fmt::Display for ThetaText {
                 f.pad(&text)
             }
         }
+    }
+}
+
+/// Multiples of pi written symbolically, each with its value computed the way the parser
+/// computes it (factors multiplied left to right from 1, then divided), so the text reads back
+/// to the identical `f32`.
+const PI_FORMS: [(&str, f32, f32); 8] = [
+    ("pi", 1.0, 1.0),
+    ("pi/2", 1.0, 2.0),
+    ("pi/3", 1.0, 3.0),
+    ("pi/4", 1.0, 4.0),
+    ("pi/6", 1.0, 6.0),
+    ("2*pi", 2.0, 1.0),
+    ("2*pi/3", 2.0, 3.0),
+    ("3*pi/4", 3.0, 4.0),
+];
+
+/// An angle (rad): a `PI_FORMS` text when it is exactly one, else the plain decimal.
+struct Angle(f32);
+
+impl fmt::Display for Angle {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let pi = core::f32::consts::PI;
+        for (text, k, n) in PI_FORMS {
+            // The parser computes ((1 · k) · pi) / n; multiplying by 1 and dividing by 1 are
+            // exact, so this is bitwise its value.
+            let value = k * pi / n;
+            if self.0.to_bits() == value.to_bits() {
+                return f.pad(text);
+            }
+            if self.0.to_bits() == (-value).to_bits() {
+                let mut signed: heapless::String<8> = heapless::String::new();
+                write!(signed, "-{text}")?;
+                return f.pad(&signed);
+            }
+        }
+        fmt::Display::fmt(&self.0, f)
     }
 }

@@ -55,10 +55,15 @@ pub struct ProjectedLink {
     pub z0: f32,
     /// Camera depth of the axis end (mm).
     pub z1: f32,
-    /// Projected radius at the axis start and end (px).
-    pub r0: f32,
-    /// Projected radius at the axis end (px).
-    pub r1: f32,
+    /// Distance from the image axis to each silhouette line at the axis start (px), for the
+    /// side along the axis normal `(−d_y, d_x)` and the opposite side: exact under perspective
+    /// (the image lines of the two planes through the camera centre tangent to the cylinder).
+    pub r0: [f32; 2],
+    /// The same at the axis end (px).
+    pub r1: [f32; 2],
+    /// Distance along the image axis from `b` to the outline of the capsule's end sphere (px):
+    /// where a fingertip's silhouette ends.
+    pub tip_offset: f32,
     /// Image bounds of the whole capsule (px).
     pub bounds: Bounds,
 }
@@ -81,9 +86,16 @@ impl ProjectedLink {
         (s, (self.a + d * s - p).norm())
     }
 
-    /// Projected radius at axis parameter `s` (px).
+    /// Mean projected radius at axis parameter `s` (px).
     pub fn radius_at(&self, s: f32) -> f32 {
-        self.r0 + (self.r1 - self.r0) * s
+        0.5 * (self.side_radius_at(s, 1) + self.side_radius_at(s, -1))
+    }
+
+    /// Distance from the image axis to the silhouette on side `side` (+1 along the normal
+    /// `(−d_y, d_x)`, −1 opposite) at axis parameter `s` (px).
+    pub fn side_radius_at(&self, s: f32, side: i8) -> f32 {
+        let k = usize::from(side < 0);
+        self.r0[k] + (self.r1[k] - self.r0[k]) * s
     }
 
     /// Camera depth of the axis at parameter `s` (mm).
@@ -191,9 +203,9 @@ impl ProjectedModel {
                     };
                     let z0 = camera.to_camera(&p0).z;
                     let z1 = camera.to_camera(&p1).z;
-                    let r0 = camera.pixels_at_depth(radius, z0);
-                    let r1 = camera.pixels_at_depth(radius, z1);
-                    let bounds = Bounds::around(a, b, r0.max(r1));
+                    let (r0, r1) = silhouette_offsets(camera, &p0, &p1, radius, &a, &b);
+                    let tip_offset = sphere_outline_offset(camera, &p1, radius, &a, &b);
+                    let bounds = Bounds::around(a, b, r0[0].max(r0[1]).max(r1[0]).max(r1[1]));
                     if !overlaps(&bounds, &frame_bounds) {
                         self.skipped.off_frame += 1;
                         continue;
@@ -219,6 +231,7 @@ impl ProjectedModel {
                         z1,
                         r0,
                         r1,
+                        tip_offset,
                         bounds,
                     });
                 }
@@ -283,4 +296,111 @@ fn project_box(
         lo,
         hi,
     })
+}
+
+/// Image normal `(−d_y, d_x)` of the axis from `a` to `b`.
+fn image_normal(a: &Vector2<f32>, b: &Vector2<f32>) -> Vector2<f32> {
+    let d = b - a;
+    let len = d.norm().max(1e-6);
+    Vector2::new(-d.y / len, d.x / len)
+}
+
+/// Offsets (px) from the image axis to the two silhouette lines of the cylinder of radius
+/// `radius` around `p0`–`p1`, at `a` and at `b`, each `[side +1, side −1]`. The silhouette
+/// lines are the images of the two planes through the camera centre tangent to the cylinder;
+/// falls back to `f·R/z` when the camera is inside the cylinder.
+fn silhouette_offsets(
+    camera: &Camera,
+    p0: &Vector3<f32>,
+    p1: &Vector3<f32>,
+    radius: f32,
+    a: &Vector2<f32>,
+    b: &Vector2<f32>,
+) -> ([f32; 2], [f32; 2]) {
+    let fallback = |z: f32| {
+        let r = camera.pixels_at_depth(radius, z);
+        [r, r]
+    };
+    let approx = (
+        fallback(camera.to_camera(p0).z),
+        fallback(camera.to_camera(p1).z),
+    );
+    let axis = p1 - p0;
+    let Some(d) = axis.try_normalize(1e-6) else {
+        return approx;
+    };
+    let rel = p0 - camera.centre();
+    let w = rel - d * rel.dot(&d);
+    let dist = w.norm();
+    if dist <= radius * 1.001 {
+        return approx;
+    }
+    let w = w / dist;
+    let m = d.cross(&w);
+    let sin = radius / dist;
+    let cos = libm::sqrtf(1.0 - sin * sin);
+    let normal = image_normal(a, b);
+    let mut out = approx;
+    for sign in [1.0f32, -1.0] {
+        let n_c = camera.r * (m * cos + w * (sign * sin));
+        let l = Vector3::new(
+            n_c.x / camera.fx,
+            n_c.y / camera.fy,
+            n_c.z - n_c.x * camera.cx / camera.fx - n_c.y * camera.cy / camera.fy,
+        );
+        let along = l.x * normal.x + l.y * normal.y;
+        if along.abs() < 1e-12 {
+            return approx;
+        }
+        let at = |p: &Vector2<f32>| -(l.x * p.x + l.y * p.y + l.z) / along;
+        let (o0, o1) = (at(a), at(b));
+        let k = usize::from(o0 + o1 < 0.0);
+        out.0[k] = o0.abs();
+        out.1[k] = o1.abs();
+    }
+    out
+}
+
+/// Distance (px) along the image axis direction from `b` (the image of the sphere centre `c`)
+/// to the outline of the sphere of radius `radius` at `c`: exact, since the image line through
+/// `b` along the axis back-projects to a plane through the camera centre and `c`.
+fn sphere_outline_offset(
+    camera: &Camera,
+    c: &Vector3<f32>,
+    radius: f32,
+    a: &Vector2<f32>,
+    b: &Vector2<f32>,
+) -> f32 {
+    let z = camera.to_camera(c).z;
+    let approx = camera.pixels_at_depth(radius, z);
+    let d = b - a;
+    let len = d.norm();
+    if len < 1e-6 {
+        return approx;
+    }
+    let dir = d / len;
+    let ray = |p: Vector2<f32>| {
+        Vector3::new((p.x - camera.cx) / camera.fx, (p.y - camera.cy) / camera.fy, 1.0).normalize()
+    };
+    let to_centre = camera.to_camera(c);
+    let dist = to_centre.norm();
+    if dist <= radius * 1.001 {
+        return approx;
+    }
+    let rc = to_centre / dist;
+    let beside = ray(b + dir * 10.0);
+    let Some(t) = (beside - rc * beside.dot(&rc)).try_normalize(1e-9) else {
+        return approx;
+    };
+    let sin = radius / dist;
+    let cos = libm::sqrtf(1.0 - sin * sin);
+    let tangent = rc * cos + t * sin;
+    if tangent.z < 1e-6 {
+        return approx;
+    }
+    let uv = Vector2::new(
+        camera.fx * tangent.x / tangent.z + camera.cx,
+        camera.fy * tangent.y / tangent.z + camera.cy,
+    );
+    dir.dot(&(uv - b))
 }
