@@ -56,7 +56,7 @@ impl Default for FeatureConfig {
             slices_per_link: 5,
             window_px: 20,
             min_contrast: 4.0,
-            span: [0.3, 0.8],
+            span: [0.15, 0.85],
             min_link_px: 6.0,
             polarity: Polarity::DarkOutside,
             mask_occluded: true,
