@@ -66,7 +66,9 @@ impl Camera {
         if self.width == 0 || self.height == 0 {
             return Err(CameraError::ZeroSize);
         }
-        let finite = [self.fx, self.fy, self.cx, self.cy].iter().all(|v| v.is_finite())
+        let finite = [self.fx, self.fy, self.cx, self.cy]
+            .iter()
+            .all(|v| v.is_finite())
             && self.r.iter().all(|v| v.is_finite())
             && self.t.iter().all(|v| v.is_finite());
         if !finite {
@@ -93,29 +95,32 @@ impl Camera {
     }
 
     /// Pixel of a world point, or `None` when it lies within [`MIN_DEPTH`] of the camera
-    /// plane or behind it.
+    /// plane or behind it, or is not finite (NaN or infinite coordinates, or a pixel that
+    /// overflows `f32`).
     pub fn project(&self, p_w: &Vector3<f32>) -> Option<Vector2<f32>> {
         let c = self.to_camera(p_w);
-        if c.z < MIN_DEPTH {
+        if !(c.z >= MIN_DEPTH && c.z.is_finite()) {
             return None;
         }
-        Some(Vector2::new(
-            self.fx * c.x / c.z + self.cx,
-            self.fy * c.y / c.z + self.cy,
-        ))
+        let uv = Vector2::new(self.fx * c.x / c.z + self.cx, self.fy * c.y / c.z + self.cy);
+        (uv.x.is_finite() && uv.y.is_finite()).then_some(uv)
     }
 
-    /// Pixel of a world point, its depth `z_c` (mm), and `∂(u, v)/∂p_w` (px/mm).
+    /// Pixel of a world point, its depth `z_c` (mm), and `∂(u, v)/∂p_w` (px/mm); `None` where
+    /// [`Camera::project`] would, for the same reasons.
     pub fn project_with_jacobian(
         &self,
         p_w: &Vector3<f32>,
     ) -> Option<(Vector2<f32>, f32, Matrix2x3<f32>)> {
         let c = self.to_camera(p_w);
-        if c.z < MIN_DEPTH {
+        if !(c.z >= MIN_DEPTH && c.z.is_finite()) {
             return None;
         }
         let iz = 1.0 / c.z;
         let uv = Vector2::new(self.fx * c.x * iz + self.cx, self.fy * c.y * iz + self.cy);
+        if !(uv.x.is_finite() && uv.y.is_finite()) {
+            return None;
+        }
         let d_cam = Matrix2x3::new(
             self.fx * iz,
             0.0,

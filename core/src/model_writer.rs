@@ -18,7 +18,8 @@ use crate::model::{Link, Model, Shape, Theta, BASE_STATES, DEFAULT_BOX_CENTRE};
 
 /// Writes `model` as `hand.dh` text to `out`. Errors only when `out` does.
 pub fn write_dh<W: Write>(model: &Model, out: &mut W) -> fmt::Result {
-    const HEADER: &str = "# frame  name            theta   d      a      alpha   shape            next";
+    const HEADER: &str =
+        "# frame  name            theta   d      a      alpha   shape            next";
     // The 1-based line the next `writeln!` lands on.
     let mut line: u32 = 1;
     for (index, link) in model.links().iter().enumerate() {
