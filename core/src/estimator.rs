@@ -355,18 +355,31 @@ pub fn edge_residual(link: &ProjectedLink, edge: &EdgePoint) -> f32 {
     link.side_radius_at(s, edge.side) - f32::from(edge.side) * normal.dot(&(edge.position - link.a))
 }
 
-/// The edge-point residual (px) and its derivative row (into `row`), from the derivative of a
-/// fixed point's distance to a moving line: `σ n·((1−s) ∂a + s ∂b) + ∂r(s)`.
+/// The edge-point residual (px) and its derivative row (into `row`): the derivative of a fixed
+/// point's distance to a moving line, `σ n·((1−s) ∂a + s ∂b)`, plus that of the predicted
+/// offset at the edge's foot `s`, `(1−s) ∂r0 + s ∂r1 + (r1 − r0) ∂s` (the foot slides when the
+/// link moves along its axis, and the image radius tapers under perspective).
 pub fn edge_row(link: &ProjectedLink, jac: &LinkJacobian, edge: &EdgePoint, row: &mut Row) -> f32 {
     let (_, normal) = axis_frame(&link.a, &link.b);
     let axis = link.b - link.a;
-    let s = ((edge.position - link.a).dot(&axis) / axis.norm_squared().max(1e-9)).clamp(0.0, 1.0);
+    let len2 = axis.norm_squared().max(1e-9);
+    let rel = edge.position - link.a;
+    let raw_s = rel.dot(&axis) / len2;
+    let s = raw_s.clamp(0.0, 1.0);
+    let inside = (0.0..=1.0).contains(&raw_s);
+    let taper = link.side_radius_at(1.0, edge.side) - link.side_radius_at(0.0, edge.side);
     let side = f32::from(edge.side);
     row.clear();
     for k in 0..jac.states.len() {
         let moved = jac.da[k] * (1.0 - s) + jac.db[k] * s;
         let dr = jac.dr0[k] * (1.0 - s) + jac.dr1[k] * s;
-        let _ = row.push((jac.states[k], side * normal.dot(&moved) + dr));
+        let d_axis = jac.db[k] - jac.da[k];
+        let ds = if inside {
+            (rel.dot(&d_axis) - jac.da[k].dot(&axis) - 2.0 * raw_s * axis.dot(&d_axis)) / len2
+        } else {
+            0.0
+        };
+        let _ = row.push((jac.states[k], side * normal.dot(&moved) + dr + taper * ds));
     }
     edge_residual(link, edge)
 }

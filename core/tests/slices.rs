@@ -1,0 +1,118 @@
+//! The 1-D slice search on synthetic profiles with known sub-pixel edge positions.
+
+use digiteyes_core::features::{find_edge, find_valley, Polarity};
+
+/// A box-filtered step from `hi` (inside) to `lo` (outside) at sub-pixel position `edge`,
+/// sampled at pixel centres 0..n: what a pixel sees of an ideal edge.
+fn step_profile(n: usize, edge: f32, hi: f32, lo: f32) -> Vec<f32> {
+    (0..n)
+        .map(|k| {
+            let covered = (edge - (k as f32 - 0.5)).clamp(0.0, 1.0);
+            lo + (hi - lo) * covered
+        })
+        .collect()
+}
+
+/// Deterministic Gaussian-ish noise (sum of uniforms) so the tests are repeatable.
+fn noise(seed: &mut u64, sigma: f32) -> f32 {
+    let mut sum = 0.0;
+    for _ in 0..12 {
+        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        sum += (*seed >> 40) as f32 / (1u64 << 24) as f32;
+    }
+    (sum - 6.0) * sigma
+}
+
+#[test]
+fn step_edges_are_found_to_a_tenth_of_a_pixel() {
+    let mut worst = 0.0f32;
+    for i in 0..=70 {
+        let edge = 6.0 + i as f32 * 0.1;
+        let p = step_profile(20, edge, 160.0, 25.0);
+        let found = find_edge(&p, Polarity::DarkOutside, 4.0).expect("edge");
+        worst = worst.max((found.position - edge).abs());
+    }
+    assert!(worst < 0.1, "worst sub-pixel error {worst} px");
+}
+
+#[test]
+fn noisy_step_edges_stay_within_a_third_of_a_pixel() {
+    let mut seed = 7u64;
+    let (mut sum, mut worst, mut n) = (0.0f32, 0.0f32, 0);
+    for i in 0..200 {
+        let edge = 6.0 + (i % 70) as f32 * 0.1;
+        let mut p = step_profile(20, edge, 140.0, 30.0);
+        for v in &mut p {
+            *v += noise(&mut seed, 4.0);
+        }
+        let found = find_edge(&p, Polarity::DarkOutside, 4.0).expect("edge");
+        let e = (found.position - edge).abs();
+        sum += e;
+        worst = worst.max(e);
+        n += 1;
+    }
+    let mean = sum / n as f32;
+    assert!(mean < 0.15, "mean error {mean} px with noise σ 4");
+    assert!(worst < 0.6, "worst error {worst} px with noise σ 4");
+}
+
+#[test]
+fn the_wrong_sign_is_not_an_edge_unless_any_sign_is_asked() {
+    let p = step_profile(20, 9.3, 25.0, 160.0); // dark inside, bright outside
+    assert!(find_edge(&p, Polarity::DarkOutside, 4.0).is_none());
+    let found = find_edge(&p, Polarity::Any, 4.0).expect("edge of either sign");
+    assert!((found.position - 9.3).abs() < 0.1);
+}
+
+#[test]
+fn the_strongest_of_two_edges_wins() {
+    let mut p = step_profile(24, 15.2, 160.0, 25.0);
+    for (k, v) in p.iter_mut().enumerate() {
+        if k < 5 {
+            *v += 20.0; // a weaker step further inside
+        }
+    }
+    let found = find_edge(&p, Polarity::DarkOutside, 4.0).expect("edge");
+    assert!((found.position - 15.2).abs() < 0.1, "{}", found.position);
+}
+
+#[test]
+fn flat_short_and_faint_profiles_have_no_edge() {
+    assert!(find_edge(&[80.0; 20], Polarity::Any, 4.0).is_none());
+    assert!(find_edge(&[0.0, 255.0, 0.0], Polarity::Any, 4.0).is_none());
+    assert!(find_edge(&[], Polarity::Any, 4.0).is_none());
+    let faint = step_profile(20, 9.0, 30.0, 27.0);
+    assert!(find_edge(&faint, Polarity::DarkOutside, 4.0).is_none());
+}
+
+#[test]
+fn a_valley_between_two_shaded_surfaces_is_found() {
+    // Left surface darkens toward its silhouette (shading), the right one starts darker and
+    // brightens: the boundary is the minimum, not the steepest descent.
+    let mut worst = 0.0f32;
+    for i in 0..40 {
+        let boundary = 7.0 + i as f32 * 0.15;
+        let intensity = |x: f32| {
+            if x < boundary {
+                (100.0 + 9.0 * (boundary - x)).min(170.0)
+            } else {
+                100.0 + 6.0 * (x - boundary)
+            }
+        };
+        // Box-filter each pixel by supersampling.
+        let p: Vec<f32> = (0..20)
+            .map(|k| (0..16).map(|j| intensity(k as f32 - 0.5 + (j as f32 + 0.5) / 16.0)).sum::<f32>() / 16.0)
+            .collect();
+        let found = find_valley(&p, 4.0).expect("valley");
+        worst = worst.max((found.position - boundary).abs());
+        let steepest = find_edge(&p, Polarity::DarkOutside, 4.0).expect("descent");
+        assert!(steepest.position < boundary - 1.0, "the descent is inside the boundary");
+    }
+    assert!(worst < 0.35, "worst valley error {worst} px");
+}
+
+#[test]
+fn shallow_valleys_are_rejected() {
+    let p: Vec<f32> = (0..20).map(|k| 100.0 + ((k as f32) - 10.0).abs() * 0.2).collect();
+    assert!(find_valley(&p, 4.0).is_none());
+}
