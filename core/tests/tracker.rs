@@ -1,0 +1,102 @@
+//! The tracker's error paths and its behaviour on frames with nothing to track.
+
+use digiteyes_core::camera::{Camera, CameraError};
+use digiteyes_core::frame::{FrameError, FrameView};
+use digiteyes_core::kinematics::KinematicsError;
+use digiteyes_core::model::Model;
+use digiteyes_core::tracker::{Tracker, TrackerConfig, TrackerError};
+use nalgebra::{Matrix3, Vector3};
+
+fn camera() -> Camera {
+    Camera {
+        width: 64,
+        height: 48,
+        fx: 100.0,
+        fy: 100.0,
+        cx: 31.5,
+        cy: 23.5,
+        r: Matrix3::identity(),
+        t: Vector3::new(0.0, 0.0, 600.0),
+    }
+}
+
+fn initial() -> Vec<f32> {
+    let mut q = vec![0.0f32; 28];
+    q[0] = 1.0;
+    q
+}
+
+fn tracker(free: Option<&[u8]>) -> Result<Tracker, TrackerError> {
+    Tracker::new(Model::hand().unwrap(), &[camera()], &initial(), free, TrackerConfig::default())
+}
+
+#[test]
+fn a_frame_of_the_wrong_size_is_rejected_and_the_state_kept() {
+    let mut t = tracker(None).unwrap();
+    let data = vec![0u8; 32 * 48];
+    let frame = FrameView::packed(&data, 32, 48).unwrap();
+    let before = t.state().to_vec();
+    assert_eq!(
+        t.track(&[frame]),
+        Err(TrackerError::Frame(FrameError::WrongSize { expected_width: 64, expected_height: 48 }))
+    );
+    assert_eq!(t.state(), &before[..]);
+}
+
+#[test]
+fn the_number_of_frames_must_match_the_cameras() {
+    let mut t = tracker(None).unwrap();
+    let data = vec![0u8; 64 * 48];
+    let frame = FrameView::packed(&data, 64, 48).unwrap();
+    assert_eq!(t.track(&[]), Err(TrackerError::FrameCount));
+    assert_eq!(t.track(&[frame, frame]), Err(TrackerError::FrameCount));
+}
+
+#[test]
+fn set_up_errors() {
+    assert_eq!(tracker(Some(&[4, 28])).err(), Some(TrackerError::BadFreeState(28)));
+    let mut nan = initial();
+    nan[9] = f32::NAN;
+    let r = Tracker::new(Model::hand().unwrap(), &[camera()], &nan, None, TrackerConfig::default());
+    assert_eq!(r.err(), Some(TrackerError::State(KinematicsError::NotFinite { state: 9 })));
+    let r = Tracker::new(Model::hand().unwrap(), &[camera()], &initial()[..20], None, TrackerConfig::default());
+    assert!(matches!(r.err(), Some(TrackerError::State(KinematicsError::WrongStateCount { .. }))));
+    let r = Tracker::new(Model::hand().unwrap(), &[], &initial(), None, TrackerConfig::default());
+    assert_eq!(r.err(), Some(TrackerError::CameraCount));
+    let mut bad = camera();
+    bad.fx = -1.0;
+    let r = Tracker::new(Model::hand().unwrap(), &[bad], &initial(), None, TrackerConfig::default());
+    assert_eq!(r.err(), Some(TrackerError::Camera(CameraError::BadFocalLength)));
+    let five = [camera(); 5];
+    let r = Tracker::new(Model::hand().unwrap(), &five, &initial(), None, TrackerConfig::default());
+    assert_eq!(r.err(), Some(TrackerError::CameraCount));
+}
+
+#[test]
+fn naming_one_quaternion_state_frees_all_four() {
+    let t = tracker(Some(&[2, 8])).unwrap();
+    for i in 0..4 {
+        assert!(t.free().contains(i));
+    }
+    assert!(t.free().contains(8) && !t.free().contains(4));
+}
+
+#[test]
+fn a_black_frame_is_lost_and_leaves_a_finite_state() {
+    let mut t = tracker(None).unwrap();
+    let data = vec![0u8; 64 * 48];
+    let frame = FrameView::packed(&data, 64, 48).unwrap();
+    let report = t.track(&[frame]).unwrap();
+    assert!(report.lost);
+    assert_eq!(report.features_found, 0);
+    assert!(t.state().iter().all(|v| v.is_finite()));
+}
+
+#[test]
+fn reset_rejects_a_nan_state_and_keeps_the_old_one() {
+    let mut t = tracker(None).unwrap();
+    let mut bad = initial();
+    bad[0] = f32::NAN;
+    assert!(t.reset(&bad).is_err());
+    assert_eq!(t.state(), &initial()[..]);
+}
