@@ -160,13 +160,8 @@ pub struct LinkJacobian {
 impl LinkJacobian {
     /// Computes the derivatives of link `link`'s image axis and radii (Eq. 2.16 through the
     /// camera). Left empty if an end does not project.
-    pub fn compute(
-        &mut self,
-        model: &Model,
-        poses: &Poses,
-        camera: &Camera,
-        link: &ProjectedLink,
-    ) {
+    #[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
+    pub fn compute(&mut self, model: &Model, poses: &Poses, camera: &Camera, link: &ProjectedLink) {
         self.states.clear();
         self.da.clear();
         self.db.clear();
@@ -186,8 +181,12 @@ impl LinkJacobian {
             let _ = self.states.push(*s);
             let _ = self.da.push(j0 * v0);
             let _ = self.db.push(j1 * v1);
-            let _ = self.dr0.push(-link.radius_at(0.0) / z0 * (depth_row * v0)[0]);
-            let _ = self.dr1.push(-link.radius_at(1.0) / z1 * (depth_row * v1)[0]);
+            let _ = self
+                .dr0
+                .push(-link.radius_at(0.0) / z0 * (depth_row * v0)[0]);
+            let _ = self
+                .dr1
+                .push(-link.radius_at(1.0) / z1 * (depth_row * v1)[0]);
         }
     }
 }
@@ -270,6 +269,7 @@ impl NormalEquations {
 
     /// The conditioned Gauss–Newton step `−(JᵀWJ + S)⁻¹ JᵀWr` for the free states (zero for
     /// the others), or `None` if the system is not positive definite or not finite.
+    #[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
     pub fn step(
         &self,
         n_states: usize,
@@ -307,6 +307,7 @@ pub struct LinkRows {
 }
 
 /// Adds the rows of one link's features to `ne`.
+#[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
 pub fn add_link_rows(
     ne: &mut NormalEquations,
     link: &ProjectedLink,
@@ -427,7 +428,8 @@ pub fn fit_axis_line(
     let mut points: Vec<Vector2<f32>, { crate::features::MAX_LINK_EDGES }> = Vec::new();
     for e in &features.edges {
         let s = ((e.position - link.a).dot(&axis) / len2).clamp(0.0, 1.0);
-        let _ = points.push(e.position - normal * (f32::from(e.side) * link.side_radius_at(s, e.side)));
+        let _ =
+            points.push(e.position - normal * (f32::from(e.side) * link.side_radius_at(s, e.side)));
     }
     let first = total_least_squares(&points, None)?;
     let mut deviations: Vec<f32, { crate::features::MAX_LINK_EDGES }> = Vec::new();

@@ -198,11 +198,16 @@ pub struct LinkFeatures {
 pub fn axis_frame(a: &Vector2<f32>, b: &Vector2<f32>) -> (Vector2<f32>, Vector2<f32>) {
     let d = b - a;
     let len = d.norm();
-    let dir = if len > 1e-6 { d / len } else { Vector2::new(1.0, 0.0) };
+    let dir = if len > 1e-6 {
+        d / len
+    } else {
+        Vector2::new(1.0, 0.0)
+    };
     (dir, Vector2::new(-dir.y, dir.x))
 }
 
 /// Runs the slice and tip searches for link `index` of `view` on `frame`, into `out`.
+#[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
 pub fn find_link_features(
     view: &ProjectedModel,
     camera: &Camera,
@@ -224,35 +229,36 @@ pub fn find_link_features(
     let (dir, normal) = axis_frame(&link.a, &link.b);
     let slices = usize::from(config.slices_per_link).clamp(1, MAX_SLICES_PER_LINK);
     let mut profile = [0.0f32; MAX_WINDOW];
-    let mut search = |centre: Vector2<f32>, outward: Vector2<f32>, depth: f32, out: &mut LinkFeatures| {
-        let mut over_hand = false;
-        if config.mask_occluded {
-            match cover(view, camera, index, &centre, depth) {
-                Cover::Hidden => {
-                    out.masked += 1;
-                    return None;
-                }
-                Cover::Behind => over_hand = true,
-                Cover::Clear => {
-                    over_hand = cover(view, camera, index, &(centre + outward * 2.0), depth)
-                        != Cover::Clear;
+    let mut search =
+        |centre: Vector2<f32>, outward: Vector2<f32>, depth: f32, out: &mut LinkFeatures| {
+            let mut over_hand = false;
+            if config.mask_occluded {
+                match cover(view, camera, index, &centre, depth) {
+                    Cover::Hidden => {
+                        out.masked += 1;
+                        return None;
+                    }
+                    Cover::Behind => over_hand = true,
+                    Cover::Clear => {
+                        over_hand = cover(view, camera, index, &(centre + outward * 2.0), depth)
+                            != Cover::Clear;
+                    }
                 }
             }
-        }
-        let start = centre - outward * half;
-        if !frame.sample_segment(start, outward, &mut profile[..window]) {
-            out.off_frame += 1;
-            return None;
-        }
-        out.expected += 1;
-        let edge = if over_hand {
-            find_valley(&profile[..window], config.min_contrast)
-                .or_else(|| find_edge(&profile[..window], Polarity::Any, config.min_contrast))?
-        } else {
-            find_edge(&profile[..window], config.polarity, config.min_contrast)?
+            let start = centre - outward * half;
+            if !frame.sample_segment(start, outward, &mut profile[..window]) {
+                out.off_frame += 1;
+                return None;
+            }
+            out.expected += 1;
+            let edge = if over_hand {
+                find_valley(&profile[..window], config.min_contrast)
+                    .or_else(|| find_edge(&profile[..window], Polarity::Any, config.min_contrast))?
+            } else {
+                find_edge(&profile[..window], config.polarity, config.min_contrast)?
+            };
+            Some((start + outward * edge.position, edge.strength))
         };
-        Some((start + outward * edge.position, edge.strength))
-    };
     for k in 0..slices {
         let s = if slices == 1 {
             0.5 * (config.span[0] + config.span[1])

@@ -118,6 +118,7 @@ impl Poses {
     }
 
     /// Recomputes the poses in place for new states `q`.
+    #[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
     pub fn update(&mut self, model: &Model, q: &[f32]) -> Result<(), KinematicsError> {
         if q.len() != model.n_states() {
             return Err(KinematicsError::WrongStateCount {
@@ -206,7 +207,9 @@ impl Poses {
         let mut cursor = Some(shape_frame);
         let start = out.len();
         while let Some(f) = cursor {
-            let Some(link) = model.links().get(f) else { break };
+            let Some(link) = model.links().get(f) else {
+                break;
+            };
             if let Theta::State(s) = link.theta {
                 let w = &self.frame[f];
                 let n = w.r.column(2).into_owned();

@@ -242,15 +242,15 @@ impl Model {
             let line = index as u32 + 1;
             let content = raw.split('#').next().unwrap_or("");
             let mut tokens = content.split_whitespace().peekable();
-            let Some(&first) = tokens.peek() else { continue };
+            let Some(&first) = tokens.peek() else {
+                continue;
+            };
             let err = |kind| ModelError { line, kind };
             if first == "limit" {
                 tokens.next();
                 let (state, limit) = parse_limit(&mut tokens).map_err(err)?;
                 match limits.get_mut(state) {
-                    Some(slot) if state >= BASE_STATES && state < n_states => {
-                        *slot = Some(limit)
-                    }
+                    Some(slot) if state >= BASE_STATES && state < n_states => *slot = Some(limit),
                     _ => return Err(err(ModelErrorKind::BadLimit)),
                 }
                 continue;
@@ -322,7 +322,9 @@ impl Model {
 
     /// The frame whose theta is joint state `state`, if `state` is a joint state.
     pub fn joint_frame(&self, state: usize) -> Option<usize> {
-        (BASE_STATES..self.n_states()).contains(&state).then(|| usize::from(self.state_frame[state]))
+        (BASE_STATES..self.n_states())
+            .contains(&state)
+            .then(|| usize::from(self.state_frame[state]))
     }
 
     /// The range of joint state `state`, when the model gives one.
@@ -394,7 +396,9 @@ fn parse_row<'a>(
     let theta = if theta_token == "base" {
         Theta::Base
     } else if let Some(n) = theta_token.strip_prefix('q') {
-        let n: u16 = n.parse().map_err(|_| ModelErrorKind::UnknownToken("theta"))?;
+        let n: u16 = n
+            .parse()
+            .map_err(|_| ModelErrorKind::UnknownToken("theta"))?;
         if usize::from(n) >= MAX_STATES {
             return Err(ModelErrorKind::TooManyStates);
         }
@@ -434,7 +438,9 @@ fn parse_row<'a>(
         if tok == "at" && !saw_next {
             if let Shape::Box { centre, .. } = &mut shape {
                 for c in centre.iter_mut() {
-                    let t = tokens.next().ok_or(ModelErrorKind::MissingField("box centre"))?;
+                    let t = tokens
+                        .next()
+                        .ok_or(ModelErrorKind::MissingField("box centre"))?;
                     *c = parse_number(t, "box centre")?;
                 }
                 continue;
@@ -450,7 +456,9 @@ fn parse_row<'a>(
             continue;
         }
         saw_next = true;
-        let child: u16 = tok.parse().map_err(|_| ModelErrorKind::UnknownToken("next"))?;
+        let child: u16 = tok
+            .parse()
+            .map_err(|_| ModelErrorKind::UnknownToken("next"))?;
         if usize::from(child) >= MAX_FRAMES {
             return Err(ModelErrorKind::MissingFrame { frame: child });
         }
@@ -487,8 +495,14 @@ fn parse_limit<'a>(
         .ok_or(ModelErrorKind::UnknownToken("limit state"))?
         .parse::<usize>()
         .map_err(|_| ModelErrorKind::UnknownToken("limit state"))?;
-    let lo = parse_number(tokens.next().ok_or(ModelErrorKind::MissingField("lo"))?, "lo")?;
-    let hi = parse_number(tokens.next().ok_or(ModelErrorKind::MissingField("hi"))?, "hi")?;
+    let lo = parse_number(
+        tokens.next().ok_or(ModelErrorKind::MissingField("lo"))?,
+        "lo",
+    )?;
+    let hi = parse_number(
+        tokens.next().ok_or(ModelErrorKind::MissingField("hi"))?,
+        "hi",
+    )?;
     if tokens.next().is_some() {
         return Err(ModelErrorKind::TrailingTokens);
     }
@@ -582,7 +596,9 @@ fn link_tree(links: &mut Vec<Link, MAX_FRAMES>) -> Result<Vec<u8, MAX_FRAMES>, M
             if order.push(c).is_err() {
                 return Err(ModelError {
                     line: links[f].line,
-                    kind: ModelErrorKind::Cycle { frame: u16::from(c) },
+                    kind: ModelErrorKind::Cycle {
+                        frame: u16::from(c),
+                    },
                 });
             }
         }

@@ -123,7 +123,11 @@ impl ProjectedPalm {
         if !self.bounds.contains(p) {
             return None;
         }
-        let ray = Vector3::new((p.x - camera.cx) / camera.fx, (p.y - camera.cy) / camera.fy, 1.0);
+        let ray = Vector3::new(
+            (p.x - camera.cx) / camera.fx,
+            (p.y - camera.cy) / camera.fy,
+            1.0,
+        );
         let dir = self.to_palm * ray;
         let (mut t_in, mut t_out) = (0.0f32, f32::INFINITY);
         for k in 0..3 {
@@ -181,6 +185,7 @@ impl ProjectedModel {
 
     /// Projects every capsule link and the palm of `model` at `poses` into `camera`.
     /// Links shorter than `min_length_px` in the image are skipped as end-on.
+    #[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
     pub fn update(&mut self, model: &Model, poses: &Poses, camera: &Camera, min_length_px: f32) {
         self.links.clear();
         self.palm = None;
@@ -192,7 +197,9 @@ impl ProjectedModel {
         for (i, link) in model.links().iter().enumerate() {
             match link.shape {
                 Shape::Cylinder { radius } => {
-                    let Some(&child) = link.children.first() else { continue };
+                    let Some(&child) = link.children.first() else {
+                        continue;
+                    };
                     let (Some(p0), Some(p1)) = (poses.origin(i), poses.origin(usize::from(child)))
                     else {
                         continue;
@@ -380,7 +387,12 @@ fn sphere_outline_offset(
     }
     let dir = d / len;
     let ray = |p: Vector2<f32>| {
-        Vector3::new((p.x - camera.cx) / camera.fx, (p.y - camera.cy) / camera.fy, 1.0).normalize()
+        Vector3::new(
+            (p.x - camera.cx) / camera.fx,
+            (p.y - camera.cy) / camera.fy,
+            1.0,
+        )
+        .normalize()
     };
     let to_centre = camera.to_camera(c);
     let dist = to_centre.norm();

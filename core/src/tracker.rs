@@ -311,7 +311,12 @@ impl Tracker {
             .zip(frames.iter())
             .zip(work.views.iter_mut())
         {
-            view.update(&self.model, &work.poses, camera, config.features.min_link_px);
+            view.update(
+                &self.model,
+                &work.poses,
+                camera,
+                config.features.min_link_px,
+            );
             let skipped = view.skipped;
             report.links_skipped += skipped.behind + skipped.end_on + skipped.off_frame;
             for index in 0..view.links.len() {
@@ -323,7 +328,8 @@ impl Tracker {
                     &config.features,
                     &mut work.features,
                 );
-                let found = work.features.edges.len() as u16 + u16::from(work.features.tip.is_some());
+                let found =
+                    work.features.edges.len() as u16 + u16::from(work.features.tip.is_some());
                 report.features_found += found;
                 report.features_expected += work.features.expected;
                 report.features_masked += work.features.masked;
@@ -331,7 +337,8 @@ impl Tracker {
                     continue;
                 }
                 let link = &view.links[index];
-                work.jacobian.compute(&self.model, &work.poses, camera, link);
+                work.jacobian
+                    .compute(&self.model, &work.poses, camera, link);
                 add_link_rows(
                     &mut work.normal,
                     link,
