@@ -506,7 +506,7 @@ fn compute_rejects_bad_state_vectors() {
         Poses::compute(&m, &q).unwrap_err(),
         KinematicsError::ZeroQuaternion
     );
-    // Squares underflowing to zero count as zero.
+    // A quaternion far below unit scale (norm < 1e-12, here its square underflows) is zero.
     q[2] = 1e-30;
     assert_eq!(
         Poses::compute(&m, &q).unwrap_err(),
