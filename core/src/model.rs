@@ -183,7 +183,7 @@ pub enum ModelErrorKind {
     NameTooLong,
     /// A `limit` row naming a state that is not a joint, or with `lo > hi`.
     BadLimit,
-    /// The text holds no frame.
+    /// The text holds no frame (reported on its last line, or line 0 for an empty text).
     Empty,
 }
 
@@ -333,8 +333,10 @@ impl Model {
     }
 
     /// Sets (or clears) the range of joint state `state`; false if it is not a joint state.
+    /// Also false, changing nothing, for a range that is not finite or has `lo > hi`.
     pub fn set_limit(&mut self, state: usize, limit: Option<Limit>) -> bool {
-        if self.joint_frame(state).is_none() {
+        let valid = limit.is_none_or(|l| l.lo.is_finite() && l.hi.is_finite() && l.lo <= l.hi);
+        if self.joint_frame(state).is_none() || !valid {
             return false;
         }
         self.limits[state] = limit;

@@ -9,6 +9,8 @@ use digiteyes_core::model::Model;
 use digiteyes_core::projection::{ProjectedLink, ProjectedModel};
 use nalgebra::{Matrix3, Vector2, Vector3};
 
+const H: f32 = std::f32::consts::FRAC_1_SQRT_2;
+
 /// The sample-mouse fixture's camera (~45° above a palm-down hand).
 fn camera() -> Camera {
     Camera {
@@ -18,10 +20,8 @@ fn camera() -> Camera {
         fy: 1000.0,
         cx: 319.5,
         cy: 239.5,
-        r: Matrix3::new(
-            0.70710678, -0.70710678, 0.0, -0.5, -0.5, -0.70710678, 0.5, 0.5, -0.70710678,
-        ),
-        t: Vector3::new(26.154061, 25.070264, 520.08284),
+        r: Matrix3::new(H, -H, 0.0, -0.5, -0.5, -H, 0.5, 0.5, -H),
+        t: Vector3::new(26.15406, 25.07026, 520.0828),
     }
 }
 
@@ -45,8 +45,11 @@ fn view_at(model: &Model, q: &[f32], camera: &Camera) -> ProjectedModel {
     view
 }
 
-fn find<'a>(view: &'a ProjectedModel, frame: u8) -> &'a ProjectedLink {
-    view.links.iter().find(|l| l.frame == frame).expect("link in view")
+fn find(view: &ProjectedModel, frame: u8) -> &ProjectedLink {
+    view.links
+        .iter()
+        .find(|l| l.frame == frame)
+        .expect("link in view")
 }
 
 /// Central differences of `residual(view)` for state `j`, steps in radians or mm.
@@ -68,7 +71,10 @@ fn check_row(
 ) {
     let scale = row.iter().fold(0.0f32, |m, (_, v)| m.max(v.abs()));
     for j in 0..28 {
-        let analytic = row.iter().find(|(s, _)| usize::from(*s) == j).map_or(0.0, |(_, v)| *v);
+        let analytic = row
+            .iter()
+            .find(|(s, _)| usize::from(*s) == j)
+            .map_or(0.0, |(_, v)| *v);
         let fd = numeric(model, q, j, residual);
         // The radius derivative uses the f·R/z form of the exact perspective offset (0.5% seen
         // here): allow 1% of the row's largest entry plus f32 differencing noise.
@@ -94,12 +100,28 @@ fn edge_point_rows_match_finite_differences_on_every_link() {
         jac.compute(&model, &poses, &cam, link);
         let (_, normal) = axis_frame(&link.a, &link.b);
         for (s, side, shift) in [(0.3f32, 1i8, 1.5f32), (0.7, -1, -2.0)] {
-            let predicted = link.a + (link.b - link.a) * s + normal * (f32::from(side) * link.side_radius_at(s, side));
-            let edge = EdgePoint { s, side, position: predicted + normal * shift, strength: 50.0 };
+            let predicted = link.a
+                + (link.b - link.a) * s
+                + normal * (f32::from(side) * link.side_radius_at(s, side));
+            let edge = EdgePoint {
+                s,
+                side,
+                position: predicted + normal * shift,
+                strength: 50.0,
+            };
             let r = edge_row(link, &jac, &edge, &mut row);
-            assert!((r + f32::from(side) * shift).abs() < 1e-3, "residual is predicted − measured");
+            assert!(
+                (r + f32::from(side) * shift).abs() < 1e-3,
+                "residual is predicted − measured"
+            );
             let frame = link.frame;
-            check_row(&model, &q, &row, &|v| edge_residual(find(v, frame), &edge), "edge");
+            check_row(
+                &model,
+                &q,
+                &row,
+                &|v| edge_residual(find(v, frame), &edge),
+                "edge",
+            );
         }
     }
 }
@@ -174,7 +196,11 @@ fn normal_equations_match_a_dense_computation_and_the_step_solves_them() {
         }
     }
     assert_eq!(ne.rows(), 40);
-    let s = Conditioning { quaternion: 1.0, translation: 2.0, joint: 30.0 };
+    let s = Conditioning {
+        quaternion: 1.0,
+        translation: 2.0,
+        joint: 30.0,
+    };
     let delta = ne.step(28, free, &s).expect("positive definite");
     for i in 0..28 {
         if !free.contains(i) {
@@ -185,7 +211,11 @@ fn normal_equations_match_a_dense_computation_and_the_step_solves_them() {
         for j in 0..28 {
             lhs += dense[i][j] * f64::from(delta[j]);
         }
-        assert!((lhs + rhs[i]).abs() < 1e-3 * (1.0 + rhs[i].abs()), "row {i}: {lhs} vs {}", -rhs[i]);
+        assert!(
+            (lhs + rhs[i]).abs() < 1e-3 * (1.0 + rhs[i].abs()),
+            "row {i}: {lhs} vs {}",
+            -rhs[i]
+        );
     }
 }
 
@@ -218,12 +248,24 @@ fn the_axis_line_fit_rejects_an_outlier_and_uses_single_silhouettes() {
     for k in 0..5 {
         let s = 0.15 + 0.175 * k as f32;
         let shift = if k == 2 { 9.0 } else { 1.0 };
-        let position = link.a + (link.b - link.a) * s + normal * (link.side_radius_at(s, 1) + shift);
-        features.edges.push(EdgePoint { s, side: 1, position, strength: 40.0 }).unwrap();
+        let position =
+            link.a + (link.b - link.a) * s + normal * (link.side_radius_at(s, 1) + shift);
+        features
+            .edges
+            .push(EdgePoint {
+                s,
+                side: 1,
+                position,
+                strength: 40.0,
+            })
+            .unwrap();
     }
     let (point, line_normal) = fit_axis_line(&link, &features).expect("line");
     let offset_a = line_normal.dot(&(link.a - point)).abs();
     let offset_b = line_normal.dot(&(link.b - point)).abs();
-    assert!((offset_a - 1.0).abs() < 0.1 && (offset_b - 1.0).abs() < 0.1, "{offset_a} {offset_b}");
+    assert!(
+        (offset_a - 1.0).abs() < 0.1 && (offset_b - 1.0).abs() < 0.1,
+        "{offset_a} {offset_b}"
+    );
     let _ = Vector2::<f32>::zeros();
 }

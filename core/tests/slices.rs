@@ -17,7 +17,9 @@ fn step_profile(n: usize, edge: f32, hi: f32, lo: f32) -> Vec<f32> {
 fn noise(seed: &mut u64, sigma: f32) -> f32 {
     let mut sum = 0.0;
     for _ in 0..12 {
-        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         sum += (*seed >> 40) as f32 / (1u64 << 24) as f32;
     }
     (sum - 6.0) * sigma
@@ -101,18 +103,28 @@ fn a_valley_between_two_shaded_surfaces_is_found() {
         };
         // Box-filter each pixel by supersampling.
         let p: Vec<f32> = (0..20)
-            .map(|k| (0..16).map(|j| intensity(k as f32 - 0.5 + (j as f32 + 0.5) / 16.0)).sum::<f32>() / 16.0)
+            .map(|k| {
+                (0..16)
+                    .map(|j| intensity(k as f32 - 0.5 + (j as f32 + 0.5) / 16.0))
+                    .sum::<f32>()
+                    / 16.0
+            })
             .collect();
         let found = find_valley(&p, 4.0).expect("valley");
         worst = worst.max((found.position - boundary).abs());
         let steepest = find_edge(&p, Polarity::DarkOutside, 4.0).expect("descent");
-        assert!(steepest.position < boundary - 1.0, "the descent is inside the boundary");
+        assert!(
+            steepest.position < boundary - 1.0,
+            "the descent is inside the boundary"
+        );
     }
     assert!(worst < 0.35, "worst valley error {worst} px");
 }
 
 #[test]
 fn shallow_valleys_are_rejected() {
-    let p: Vec<f32> = (0..20).map(|k| 100.0 + ((k as f32) - 10.0).abs() * 0.2).collect();
+    let p: Vec<f32> = (0..20)
+        .map(|k| 100.0 + ((k as f32) - 10.0).abs() * 0.2)
+        .collect();
     assert!(find_valley(&p, 4.0).is_none());
 }

@@ -27,7 +27,13 @@ fn initial() -> Vec<f32> {
 }
 
 fn tracker(free: Option<&[u8]>) -> Result<Tracker, TrackerError> {
-    Tracker::new(Model::hand().unwrap(), &[camera()], &initial(), free, TrackerConfig::default())
+    Tracker::new(
+        Model::hand().unwrap(),
+        &[camera()],
+        &initial(),
+        free,
+        TrackerConfig::default(),
+    )
 }
 
 #[test]
@@ -38,7 +44,10 @@ fn a_frame_of_the_wrong_size_is_rejected_and_the_state_kept() {
     let before = t.state().to_vec();
     assert_eq!(
         t.track(&[frame]),
-        Err(TrackerError::Frame(FrameError::WrongSize { expected_width: 64, expected_height: 48 }))
+        Err(TrackerError::Frame(FrameError::WrongSize {
+            expected_width: 64,
+            expected_height: 48
+        }))
     );
     assert_eq!(t.state(), &before[..]);
 }
@@ -54,21 +63,63 @@ fn the_number_of_frames_must_match_the_cameras() {
 
 #[test]
 fn set_up_errors() {
-    assert_eq!(tracker(Some(&[4, 28])).err(), Some(TrackerError::BadFreeState(28)));
+    assert_eq!(
+        tracker(Some(&[4, 28])).err(),
+        Some(TrackerError::BadFreeState(28))
+    );
     let mut nan = initial();
     nan[9] = f32::NAN;
-    let r = Tracker::new(Model::hand().unwrap(), &[camera()], &nan, None, TrackerConfig::default());
-    assert_eq!(r.err(), Some(TrackerError::State(KinematicsError::NotFinite { state: 9 })));
-    let r = Tracker::new(Model::hand().unwrap(), &[camera()], &initial()[..20], None, TrackerConfig::default());
-    assert!(matches!(r.err(), Some(TrackerError::State(KinematicsError::WrongStateCount { .. }))));
-    let r = Tracker::new(Model::hand().unwrap(), &[], &initial(), None, TrackerConfig::default());
+    let r = Tracker::new(
+        Model::hand().unwrap(),
+        &[camera()],
+        &nan,
+        None,
+        TrackerConfig::default(),
+    );
+    assert_eq!(
+        r.err(),
+        Some(TrackerError::State(KinematicsError::NotFinite { state: 9 }))
+    );
+    let r = Tracker::new(
+        Model::hand().unwrap(),
+        &[camera()],
+        &initial()[..20],
+        None,
+        TrackerConfig::default(),
+    );
+    assert!(matches!(
+        r.err(),
+        Some(TrackerError::State(KinematicsError::WrongStateCount { .. }))
+    ));
+    let r = Tracker::new(
+        Model::hand().unwrap(),
+        &[],
+        &initial(),
+        None,
+        TrackerConfig::default(),
+    );
     assert_eq!(r.err(), Some(TrackerError::CameraCount));
     let mut bad = camera();
     bad.fx = -1.0;
-    let r = Tracker::new(Model::hand().unwrap(), &[bad], &initial(), None, TrackerConfig::default());
-    assert_eq!(r.err(), Some(TrackerError::Camera(CameraError::BadFocalLength)));
+    let r = Tracker::new(
+        Model::hand().unwrap(),
+        &[bad],
+        &initial(),
+        None,
+        TrackerConfig::default(),
+    );
+    assert_eq!(
+        r.err(),
+        Some(TrackerError::Camera(CameraError::BadFocalLength))
+    );
     let five = [camera(); 5];
-    let r = Tracker::new(Model::hand().unwrap(), &five, &initial(), None, TrackerConfig::default());
+    let r = Tracker::new(
+        Model::hand().unwrap(),
+        &five,
+        &initial(),
+        None,
+        TrackerConfig::default(),
+    );
     assert_eq!(r.err(), Some(TrackerError::CameraCount));
 }
 
