@@ -1,0 +1,53 @@
+//! The evaluation as a readable table.
+
+use std::fmt;
+
+use super::{EvalReport, LOST_ERROR_PX, LOST_RUN};
+
+impl fmt::Display for EvalReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "reprojection error (px), {} frames", self.frames)?;
+        writeln!(
+            f,
+            "  {:<12} {:>14} {:>13} {:>11} {:>10}",
+            "camera", "fingertip mean", "fingertip p95", "joint mean", "joint p95"
+        )?;
+        for c in &self.cameras {
+            writeln!(
+                f,
+                "  {:<12} {:>14.2} {:>13.2} {:>11.2} {:>10.2}",
+                c.name, c.fingertip_mean_px, c.fingertip_p95_px, c.joint_mean_px, c.joint_p95_px
+            )?;
+        }
+        if self.free_joints > 0 {
+            writeln!(
+                f,
+                "free-joint RMS error     {:8.2} deg  ({} joints)",
+                self.joint_rms_deg, self.free_joints
+            )?;
+        } else {
+            writeln!(f, "free-joint RMS error          n/a  (no free joint)")?;
+        }
+        writeln!(
+            f,
+            "palm rotation error      {:8.2} deg  mean, {:.2} deg max",
+            self.palm_rotation_deg, self.palm_rotation_max_deg
+        )?;
+        writeln!(
+            f,
+            "palm translation error   {:8.2} mm   mean, {:.2} mm max",
+            self.palm_translation_mm, self.palm_translation_max_mm
+        )?;
+        let kept = (self.track_life * self.frames as f64).round() as usize;
+        writeln!(
+            f,
+            "track life               {:8.1} %    ({kept} of {} frames before the fingertip error stays > {LOST_ERROR_PX} px for {LOST_RUN} frames)",
+            100.0 * self.track_life,
+            self.frames
+        )?;
+        if let Some(lost) = self.lost_frames {
+            writeln!(f, "frames flagged lost      {lost:8}")?;
+        }
+        Ok(())
+    }
+}

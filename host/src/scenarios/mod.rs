@@ -1,0 +1,246 @@
+//! Named synthetic sequences, rendered to disk in the format of `sequence-format.md`.
+//!
+//! A scenario ([`catalogue`]) fixes the cameras, the base pose, which states are free and how
+//! far they move. [`generate`] draws a smooth seeded trajectory ([`trajectory`]), scales its
+//! speed so the fastest fingertip peaks at the scenario's image speed, checks the hand stays
+//! in view, and [`render_scenario`] writes `sequence.json` (`model: "builtin:hand"`), the
+//! frames and `truth.csv` (every state, every frame).
+
+pub mod cameras;
+pub mod catalogue;
+pub mod measure;
+pub mod trajectory;
+
+use std::path::Path;
+
+use anyhow::{bail, ensure, Context, Result};
+use digiteyes_core::camera::Camera;
+use digiteyes_core::model::Model;
+
+use crate::render::{Background, RenderSettings, Renderer};
+use crate::sequence::{self, CameraFile, SequenceFile, BUILTIN_HAND};
+pub use catalogue::{scenario, Scenario, NAMES};
+use trajectory::Motion;
+
+/// Frames rendered unless asked otherwise.
+pub const DEFAULT_FRAMES: usize = 60;
+/// Frame rate written to `sequence.json` (frames/s).
+pub const FPS: f64 = 30.0;
+/// The hand keeps at least this far from the image border (px).
+pub const VIEW_MARGIN_PX: f32 = 2.0;
+
+/// Options of [`render_scenario`]; `None` fields take the scenario's own setting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderOptions {
+    /// Seed of the trajectory, the noise and the clutter.
+    pub seed: u64,
+    /// Frames to render; `None` for [`DEFAULT_FRAMES`]. The trajectory does not depend on it
+    /// for up to [`DEFAULT_FRAMES`] frames: a shorter sequence is the start of the default one.
+    pub frames: Option<usize>,
+    /// Noise standard deviation (grey levels).
+    pub noise: Option<f32>,
+    /// Blur standard deviation (px).
+    pub blur: Option<f32>,
+    /// Cluttered background.
+    pub clutter: Option<bool>,
+    /// Image size (px); the intrinsics scale so the view is the same.
+    pub size: Option<(u32, u32)>,
+    /// Rays per pixel along each axis.
+    pub supersample: u32,
+    /// Show a progress bar on stderr (when it is a terminal).
+    pub progress: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            seed: 1,
+            frames: None,
+            noise: None,
+            blur: None,
+            clutter: None,
+            size: None,
+            supersample: 3,
+            progress: false,
+        }
+    }
+}
+
+/// A scenario's sequence before rendering.
+#[derive(Debug, Clone)]
+pub struct Generated {
+    /// The scenario.
+    pub scenario: Scenario,
+    /// `sequence.json`.
+    pub file: SequenceFile,
+    /// The cameras of `file`, as the core sees them.
+    pub cameras: Vec<Camera>,
+    /// The true state of every frame (quaternion, mm, rad).
+    pub truth: Vec<Vec<f64>>,
+    /// How frames are rendered (camera 0; other cameras draw their own clutter and noise).
+    pub settings: RenderSettings,
+    /// Time scale of the trajectory (τ per frame).
+    pub time_scale: f64,
+}
+
+/// Draws the trajectory of scenario `name` and everything else needed to render it.
+pub fn generate(name: &str, opts: &RenderOptions) -> Result<Generated> {
+    let frames = opts.frames.unwrap_or(DEFAULT_FRAMES);
+    ensure!(frames > 0, "at least one frame is needed");
+    let scenario = catalogue::scenario(name)?;
+    let model = Model::hand().map_err(|e| anyhow::anyhow!("built-in hand model: {e}"))?;
+    let amplitudes = within_limits(&model, &scenario.base, &scenario.amplitudes);
+    let motion = Motion::random(
+        scenario.base.clone(),
+        &amplitudes,
+        scenario.rotation,
+        opts.seed,
+    );
+    // Speed is set in the first camera at the default size, so the motion depends neither on
+    // the image size nor on further cameras (`fullhand-mono` moves as `fullhand-stereo`).
+    let full_size = sequence::check_cameras(&scenario.cameras[..1])?;
+    let horizon = frames.max(DEFAULT_FRAMES);
+    let time_scale = calibrate_speed(
+        &model,
+        &full_size,
+        &motion,
+        horizon,
+        scenario.peak_tip_speed,
+    )
+    .with_context(|| format!("scenario {name}"))?;
+    let truth = motion.sample(frames, time_scale);
+    let camera_files: Vec<CameraFile> = match opts.size {
+        Some((w, h)) => scenario
+            .cameras
+            .iter()
+            .map(|c| cameras::resized(c, w, h))
+            .collect(),
+        None => scenario.cameras.clone(),
+    };
+    let cameras = sequence::check_cameras(&camera_files)?;
+    measure::check_in_view(&model, &cameras, &truth, VIEW_MARGIN_PX)
+        .with_context(|| format!("scenario {name}, seed {}", opts.seed))?;
+    let file = SequenceFile {
+        model: BUILTIN_HAND.to_string(),
+        fps: Some(FPS),
+        cameras: camera_files,
+        initial_state: truth[0].clone(),
+        free: Some(scenario.free.iter().map(|&s| s as i64).collect()),
+    };
+    let clutter = opts.clutter.unwrap_or(scenario.clutter);
+    let settings = RenderSettings {
+        supersample: opts.supersample.max(1),
+        noise_sigma: opts.noise.unwrap_or(scenario.noise),
+        blur_sigma: opts.blur.unwrap_or(scenario.blur),
+        background: if clutter {
+            Background::Clutter {
+                seed: mix(opts.seed, 0, u64::MAX),
+            }
+        } else {
+            Background::default()
+        },
+        threads: 0,
+    };
+    Ok(Generated {
+        scenario,
+        file,
+        cameras,
+        truth,
+        settings,
+        time_scale,
+    })
+}
+
+/// Renders scenario `name` into folder `out` (created if needed): `sequence.json`, the frames
+/// `camN/NNNNNN.pgm` and `truth.csv`.
+pub fn render_scenario(name: &str, out: &Path, opts: &RenderOptions) -> Result<()> {
+    let generated = generate(name, opts)?;
+    write_generated(&generated, out, opts)
+}
+
+/// Writes a generated scenario into `out`.
+pub fn write_generated(generated: &Generated, out: &Path, opts: &RenderOptions) -> Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    sequence::write_sequence_json(out, &generated.file)?;
+    sequence::write_truth(&out.join(sequence::TRUTH_CSV), &generated.truth)?;
+    let model = Model::hand().map_err(|e| anyhow::anyhow!("built-in hand model: {e}"))?;
+    let renderers: Vec<Renderer> = generated
+        .cameras
+        .iter()
+        .enumerate()
+        .map(|(c, camera)| {
+            let mut settings = generated.settings;
+            if let Background::Clutter { seed } = settings.background {
+                settings.background = Background::Clutter {
+                    seed: mix(seed, c as u64, 0),
+                };
+            }
+            Renderer::new(&model, camera, settings)
+        })
+        .collect();
+    let bar = crate::progress::bar(
+        generated.truth.len(),
+        &format!("render {}", generated.scenario.name),
+        opts.progress,
+    );
+    for (k, q) in generated.truth.iter().enumerate() {
+        let q: Vec<f32> = q.iter().map(|&v| v as f32).collect();
+        for (c, renderer) in renderers.iter().enumerate() {
+            let image = renderer
+                .render(&q, mix(opts.seed, c as u64, k as u64))
+                .with_context(|| format!("frame {k}, camera {c}"))?;
+            sequence::write_frame(out, c, k, &image)?;
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    Ok(())
+}
+
+/// Cuts each amplitude so `base ± amplitude` stays inside the model's range of that joint.
+fn within_limits(model: &Model, base: &[f64], amplitudes: &[(usize, f64)]) -> Vec<(usize, f64)> {
+    amplitudes
+        .iter()
+        .map(|&(s, a)| match model.limit(s) {
+            Some(l) => {
+                let room = (base[s] - f64::from(l.lo)).min(f64::from(l.hi) - base[s]);
+                (s, a.min(room.max(0.0)))
+            }
+            None => (s, a),
+        })
+        .collect()
+}
+
+/// The time scale (τ per frame) at which the fastest fingertip's image speed peaks at
+/// `target` px/frame over `horizon` frames.
+fn calibrate_speed(
+    model: &Model,
+    cameras: &[Camera],
+    motion: &Motion,
+    horizon: usize,
+    target: f64,
+) -> Result<f64> {
+    let mut scale = 0.01;
+    for _ in 0..20 {
+        let peak = measure::peak_tip_speed(model, cameras, &motion.sample(horizon, scale))?;
+        if peak <= 0.0 {
+            bail!("no fingertip moves");
+        }
+        let ratio = target / peak;
+        scale *= ratio;
+        if (ratio - 1.0).abs() < 1e-3 {
+            break;
+        }
+    }
+    Ok(scale)
+}
+
+/// A seed for one camera and frame, from the sequence's seed.
+fn mix(seed: u64, camera: u64, frame: u64) -> u64 {
+    let mut x = seed
+        ^ camera.wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        ^ frame.wrapping_mul(0xc2b2_ae3d_27d4_eb4f);
+    x ^= x >> 31;
+    x = x.wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    x ^ (x >> 29)
+}

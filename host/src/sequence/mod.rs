@@ -1,0 +1,333 @@
+//! Recorded sequences: the on-disk contract of `sequence-format.md`.
+//!
+//! ```text
+//! <seq>/sequence.json      model, cameras, initial state, free states, fps
+//! <seq>/cam0/000000.pgm    frame 0 of camera 0, then 000001.pgm, ... (no gaps)
+//! <seq>/truth.csv          optional ground truth (`frame,q0,...`)
+//! ```
+//!
+//! [`Sequence::open`] reads and checks everything but the pixels; frames are read one at a
+//! time with [`Sequence::read_frame`]. Every error names the file and says what is wrong.
+
+pub mod json;
+pub mod pgm;
+pub mod states;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, ensure, Context, Result};
+use digiteyes_core::camera::Camera;
+use digiteyes_core::config::MAX_CAMERAS;
+use digiteyes_core::model::Model;
+use image::GrayImage;
+
+pub use json::{CameraFile, SequenceFile, BUILTIN_HAND};
+pub use states::{read_states, write_truth, StateTable, StatesWriter};
+
+/// The name of the file describing a sequence.
+pub const SEQUENCE_JSON: &str = "sequence.json";
+/// The name of the optional ground-truth file.
+pub const TRUTH_CSV: &str = "truth.csv";
+
+/// A sequence folder, opened and checked.
+#[derive(Debug, Clone)]
+pub struct Sequence {
+    /// The sequence folder.
+    pub dir: PathBuf,
+    /// `sequence.json` as stored.
+    pub file: SequenceFile,
+    /// The kinematic model named by `model`.
+    pub model: Model,
+    /// The cameras, validated; camera `i`'s frames are in `cam{i}/`.
+    pub cameras: Vec<Camera>,
+    /// The state at frame 0 (quaternion, mm, rad), one value per model state.
+    pub initial_state: Vec<f64>,
+    /// The free states, sorted; `None` when `sequence.json` has no `free` (all are free).
+    pub free: Option<Vec<u8>>,
+    /// Frames per camera.
+    pub frames: usize,
+}
+
+impl Sequence {
+    /// Reads `dir/sequence.json` and its model, checks the cameras, the initial state and the
+    /// free list, and counts the frames of every camera (which must agree). Frame headers are
+    /// not read here: see [`Sequence::check_frames`].
+    pub fn open(dir: &Path) -> Result<Sequence> {
+        let json_path = dir.join(SEQUENCE_JSON);
+        let text = std::fs::read_to_string(&json_path)
+            .with_context(|| format!("cannot read {}", json_path.display()))?;
+        let file = SequenceFile::from_json(&text)
+            .with_context(|| format!("{}: invalid sequence description", json_path.display()))?;
+        let at = |what: String| format!("{}: {what}", json_path.display());
+        let model = load_model(dir, &file.model).with_context(|| at("model".into()))?;
+        let cameras = check_cameras(&file.cameras).with_context(|| at("cameras".into()))?;
+        let initial_state = check_initial_state(&file.initial_state, &model)
+            .with_context(|| at("initial_state".into()))?;
+        let free = match &file.free {
+            Some(list) => {
+                Some(check_free(list, model.n_states()).with_context(|| at("free".into()))?)
+            }
+            None => None,
+        };
+        let frames = count_all_frames(dir, cameras.len())?;
+        Ok(Sequence {
+            dir: dir.to_path_buf(),
+            file,
+            model,
+            cameras,
+            initial_state,
+            free,
+            frames,
+        })
+    }
+
+    /// Number of model states.
+    pub fn n_states(&self) -> usize {
+        self.model.n_states()
+    }
+
+    /// The states the tracker estimates (all when `free` is absent), sorted.
+    pub fn free_states(&self) -> Vec<usize> {
+        match &self.free {
+            Some(list) => list.iter().map(|&s| usize::from(s)).collect(),
+            None => (0..self.n_states()).collect(),
+        }
+    }
+
+    /// The name of camera `cam` for reports: its `name`, or `cam{cam}`.
+    pub fn camera_name(&self, cam: usize) -> String {
+        self.file
+            .cameras
+            .get(cam)
+            .and_then(|c| c.name.clone())
+            .unwrap_or_else(|| format!("cam{cam}"))
+    }
+
+    /// The frame rate (frames/s), when `sequence.json` gives one.
+    pub fn fps(&self) -> Option<f64> {
+        self.file.fps
+    }
+
+    /// The path of frame `frame` of camera `cam`.
+    pub fn frame_path(&self, cam: usize, frame: usize) -> PathBuf {
+        frame_path(&self.dir, cam, frame)
+    }
+
+    /// Reads frame `frame` of camera `cam`, checking it is 8-bit `P5` of the camera's size.
+    pub fn read_frame(&self, cam: usize, frame: usize) -> Result<GrayImage> {
+        let path = self.frame_path(cam, frame);
+        let image = pgm::read_pgm(&path)?;
+        self.check_size(cam, &path, image.dimensions())?;
+        Ok(image)
+    }
+
+    /// Reads the header of every frame: each must be 8-bit `P5` of its camera's size.
+    pub fn check_frames(&self) -> Result<()> {
+        for cam in 0..self.cameras.len() {
+            for frame in 0..self.frames {
+                let path = self.frame_path(cam, frame);
+                let size = pgm::read_pgm_size(&path)?;
+                self.check_size(cam, &path, size)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads `truth.csv`; an error if it is missing or does not have one row per frame.
+    pub fn read_truth(&self) -> Result<StateTable> {
+        let path = self.dir.join(TRUTH_CSV);
+        ensure!(
+            path.exists(),
+            "{}: missing (ground truth is needed for evaluation)",
+            path.display()
+        );
+        let table = read_states(&path, self.n_states())?;
+        ensure!(
+            table.rows.len() == self.frames,
+            "{}: {} rows, the sequence has {} frames",
+            path.display(),
+            table.rows.len(),
+            self.frames
+        );
+        Ok(table)
+    }
+
+    fn check_size(&self, cam: usize, path: &Path, (w, h): (u32, u32)) -> Result<()> {
+        let c = &self.cameras[cam];
+        ensure!(
+            (w, h) == (c.width, c.height),
+            "{}: frame is {w}x{h} px, camera {cam} is {}x{} px",
+            path.display(),
+            c.width,
+            c.height
+        );
+        Ok(())
+    }
+}
+
+/// Writes `dir/sequence.json`, creating `dir` and the `cam{i}` folders of its cameras.
+pub fn write_sequence_json(dir: &Path, file: &SequenceFile) -> Result<()> {
+    for cam in 0..file.cameras.len() {
+        let folder = dir.join(camera_dir_name(cam));
+        std::fs::create_dir_all(&folder)
+            .with_context(|| format!("cannot create {}", folder.display()))?;
+    }
+    let path = dir.join(SEQUENCE_JSON);
+    let text = file
+        .to_json()
+        .with_context(|| format!("cannot encode {}", path.display()))?;
+    std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Writes frame `frame` of camera `cam` into sequence folder `dir` (the folder must exist).
+pub fn write_frame(dir: &Path, cam: usize, frame: usize, image: &GrayImage) -> Result<()> {
+    pgm::write_pgm(&frame_path(dir, cam, frame), image)
+}
+
+/// The path of frame `frame` of camera `cam` in sequence folder `dir`.
+pub fn frame_path(dir: &Path, cam: usize, frame: usize) -> PathBuf {
+    dir.join(camera_dir_name(cam))
+        .join(format!("{frame:06}.pgm"))
+}
+
+/// The folder name of camera `cam`'s frames: `cam{cam}`.
+pub fn camera_dir_name(cam: usize) -> String {
+    format!("cam{cam}")
+}
+
+/// Loads the model named by `sequence.json`'s `model` field.
+pub fn load_model(dir: &Path, name: &str) -> Result<Model> {
+    if name == BUILTIN_HAND {
+        return Model::hand().map_err(|e| anyhow::anyhow!("built-in hand model: {e}"));
+    }
+    if let Some(other) = name.strip_prefix("builtin:") {
+        bail!("unknown built-in model `builtin:{other}` (the only one is `{BUILTIN_HAND}`)");
+    }
+    let path = dir.join(name);
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    Model::parse(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+}
+
+/// Converts and validates the cameras.
+pub fn check_cameras(cameras: &[CameraFile]) -> Result<Vec<Camera>> {
+    ensure!(!cameras.is_empty(), "no cameras listed");
+    ensure!(
+        cameras.len() <= MAX_CAMERAS,
+        "{} cameras listed, at most {MAX_CAMERAS} are supported",
+        cameras.len()
+    );
+    cameras
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let camera = c.to_camera();
+            camera.validate().map_err(|e| {
+                anyhow::anyhow!(
+                    "camera {i}{}: {e}",
+                    c.name
+                        .as_deref()
+                        .map(|n| format!(" ({n})"))
+                        .unwrap_or_default()
+                )
+            })?;
+            Ok(camera)
+        })
+        .collect()
+}
+
+fn check_initial_state(state: &[f64], model: &Model) -> Result<Vec<f64>> {
+    ensure!(
+        state.len() == model.n_states(),
+        "{} values, the model has {} states",
+        state.len(),
+        model.n_states()
+    );
+    if let Some(i) = state.iter().position(|v| !v.is_finite()) {
+        bail!("q{i} is not a finite number");
+    }
+    let norm = state[..4].iter().map(|v| v * v).sum::<f64>().sqrt();
+    ensure!(norm > 1e-6, "the palm quaternion q0..q3 is zero");
+    Ok(state.to_vec())
+}
+
+fn check_free(list: &[i64], n_states: usize) -> Result<Vec<u8>> {
+    let mut free = Vec::with_capacity(list.len());
+    for &s in list {
+        ensure!(
+            s >= 0 && (s as usize) < n_states,
+            "state {s} is not a state of the model (0..{})",
+            n_states.saturating_sub(1)
+        );
+        ensure!(!free.contains(&(s as u8)), "state {s} is listed twice");
+        free.push(s as u8);
+    }
+    free.sort_unstable();
+    let quaternion_free = (0..4u8).filter(|s| free.contains(s)).count();
+    ensure!(
+        quaternion_free == 0 || quaternion_free == 4,
+        "the quaternion states 0, 1, 2, 3 must be free or fixed together"
+    );
+    Ok(free)
+}
+
+/// Counts the frames of every camera; they must be numbered from 000000 without gaps and
+/// every camera must have the same number.
+fn count_all_frames(dir: &Path, cameras: usize) -> Result<usize> {
+    let mut counts = Vec::with_capacity(cameras);
+    for cam in 0..cameras {
+        counts.push(count_frames(dir, cam)?);
+    }
+    let first = counts[0];
+    for (cam, &n) in counts.iter().enumerate().skip(1) {
+        if n != first {
+            let (short, long) = if n < first { (cam, 0) } else { (0, cam) };
+            bail!(
+                "{}: missing; camera {long} has {} frames, camera {short} has {}",
+                frame_path(dir, short, n.min(first)).display(),
+                n.max(first),
+                n.min(first)
+            );
+        }
+    }
+    Ok(first)
+}
+
+fn count_frames(dir: &Path, cam: usize) -> Result<usize> {
+    let folder = dir.join(camera_dir_name(cam));
+    ensure!(
+        folder.is_dir(),
+        "{}: missing folder of camera {cam}'s frames",
+        folder.display()
+    );
+    let mut n = 0;
+    while frame_path(dir, cam, n).is_file() {
+        n += 1;
+    }
+    ensure!(
+        n > 0,
+        "{}: missing (frames are numbered from 000000)",
+        frame_path(dir, cam, 0).display()
+    );
+    // Frames past a gap would be silently ignored: the format allows no gaps.
+    let entries =
+        std::fs::read_dir(&folder).with_context(|| format!("cannot list {}", folder.display()))?;
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(stem) = name.to_str().and_then(|s| s.strip_suffix(".pgm")) else {
+            continue;
+        };
+        if stem.len() == 6 && stem.bytes().all(|b| b.is_ascii_digit()) {
+            if let Ok(k) = stem.parse::<usize>() {
+                if k > n {
+                    bail!(
+                        "{}: missing, but {} exists (frames must be numbered without gaps)",
+                        frame_path(dir, cam, n).display(),
+                        entry.path().display()
+                    );
+                }
+            }
+        }
+    }
+    Ok(n)
+}

@@ -1,0 +1,288 @@
+//! State tables as CSV: `truth.csv` and the tracker's output.
+//!
+//! Both start with the columns `frame,q0,q1,...,q{n-1}` (quaternion `w, x, y, z`, translation
+//! in mm, joint angles in rad); the tracker's output adds report columns after them. Rows are
+//! one per frame, in order, numbers as plain decimals.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use digiteyes_core::quaternion;
+use digiteyes_core::tracker::FrameReport;
+
+/// The report columns the tracker's output adds after the states.
+pub const REPORT_COLUMNS: [&str; 5] = [
+    "rms_px",
+    "iterations",
+    "features_found",
+    "features_expected",
+    "lost",
+];
+
+/// States read from a CSV file: `rows[k]` is the state at frame `k`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StateTable {
+    /// One state vector per frame (quaternion, mm, rad).
+    pub rows: Vec<Vec<f64>>,
+    /// Names of the columns after the states (e.g. [`REPORT_COLUMNS`]).
+    pub extra_columns: Vec<String>,
+    /// Values of those columns, one vector per frame (`NaN` where not a number).
+    pub extras: Vec<Vec<f64>>,
+}
+
+impl StateTable {
+    /// The values of extra column `name`, one per frame, if the file has it.
+    pub fn extra(&self, name: &str) -> Option<Vec<f64>> {
+        let i = self.extra_columns.iter().position(|c| c == name)?;
+        Some(self.extras.iter().map(|row| row[i]).collect())
+    }
+}
+
+/// The header line `frame,q0,...,q{n-1}` (no newline).
+pub fn state_header(n_states: usize) -> String {
+    let mut header = String::from("frame");
+    for i in 0..n_states {
+        header.push_str(&format!(",q{i}"));
+    }
+    header
+}
+
+/// Reads a state CSV whose first columns are `frame,q0..q{n_states-1}`; later columns are
+/// kept as extras. Frames must be numbered 0, 1, 2, ... in order.
+pub fn read_states(path: &Path, n_states: usize) -> Result<StateTable> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    parse_states(&text, n_states).with_context(|| format!("{}", path.display()))
+}
+
+/// Parses the text of a state CSV (see [`read_states`]).
+pub fn parse_states(text: &str, n_states: usize) -> Result<StateTable> {
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    let Some((_, header)) = lines.next() else {
+        bail!("empty file: expected the header `frame,q0,...`")
+    };
+    let columns: Vec<&str> = header.split(',').map(str::trim).collect();
+    let expected = state_header(n_states);
+    let expected: Vec<&str> = expected.split(',').collect();
+    let found_states = columns
+        .iter()
+        .skip(1)
+        .take_while(|c| c.starts_with('q') && c[1..].parse::<usize>().is_ok())
+        .count();
+    if found_states != n_states && columns.first() == Some(&"frame") {
+        bail!("line 1: the file has {found_states} state columns, the model has {n_states} states");
+    }
+    if columns.len() < expected.len() || columns[..expected.len()] != expected[..] {
+        bail!(
+            "line 1: header must start with `frame,q0,...,q{}`",
+            n_states.saturating_sub(1)
+        );
+    }
+    let extra_columns: Vec<String> = columns[expected.len()..]
+        .iter()
+        .map(|c| c.to_string())
+        .collect();
+    let mut table = StateTable {
+        rows: Vec::new(),
+        extra_columns,
+        extras: Vec::new(),
+    };
+    for (index, line) in lines {
+        let number = index + 1;
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        if fields.len() != columns.len() {
+            bail!(
+                "line {number}: {} fields, the header has {}",
+                fields.len(),
+                columns.len()
+            );
+        }
+        let frame: usize = fields[0]
+            .parse()
+            .with_context(|| format!("line {number}: frame `{}` is not a number", fields[0]))?;
+        if frame != table.rows.len() {
+            bail!(
+                "line {number}: frame {frame} out of order, expected frame {}",
+                table.rows.len()
+            );
+        }
+        let mut state = Vec::with_capacity(n_states);
+        for (i, field) in fields[1..=n_states].iter().enumerate() {
+            match field.parse::<f64>() {
+                Ok(v) if v.is_finite() => state.push(v),
+                _ => bail!("line {number}: q{i} = `{field}` is not a finite number"),
+            }
+        }
+        let extras = fields[n_states + 1..]
+            .iter()
+            .map(|f| f.parse::<f64>().unwrap_or(f64::NAN))
+            .collect();
+        table.rows.push(state);
+        table.extras.push(extras);
+    }
+    Ok(table)
+}
+
+/// Writes `truth.csv`: the header `frame,q0..` and one row per frame.
+pub fn write_truth(path: &Path, rows: &[Vec<f64>]) -> Result<()> {
+    let n = rows.first().map_or(0, Vec::len);
+    let mut text = state_header(n);
+    text.push('\n');
+    for (k, row) in rows.iter().enumerate() {
+        text.push_str(&k.to_string());
+        for v in row {
+            text.push_str(&format!(",{v}"));
+        }
+        text.push('\n');
+    }
+    std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Writes the tracker's output CSV row by row: `frame,q0..q{n-1}` then [`REPORT_COLUMNS`].
+/// The quaternion is normalised before writing; `lost` is written as 0 or 1.
+pub struct StatesWriter {
+    out: BufWriter<File>,
+    path: PathBuf,
+    n_states: usize,
+    frames: usize,
+}
+
+impl StatesWriter {
+    /// Creates `path` and writes the header.
+    pub fn create(path: &Path, n_states: usize) -> Result<Self> {
+        let file =
+            File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+        let mut writer = StatesWriter {
+            out: BufWriter::new(file),
+            path: path.to_path_buf(),
+            n_states,
+            frames: 0,
+        };
+        let mut header = state_header(n_states);
+        for c in REPORT_COLUMNS {
+            header.push(',');
+            header.push_str(c);
+        }
+        writer.line(&header)?;
+        Ok(writer)
+    }
+
+    /// Appends the row of the next frame.
+    pub fn write(&mut self, state: &[f32], report: &FrameReport) -> Result<()> {
+        if state.len() != self.n_states {
+            bail!(
+                "{}: state has {} values, the header {}",
+                self.path.display(),
+                state.len(),
+                self.n_states
+            );
+        }
+        let mut state = state.to_vec();
+        if state.len() >= 4 {
+            if let Some(q) = quaternion::normalised([state[0], state[1], state[2], state[3]]) {
+                state[..4].copy_from_slice(&q);
+            }
+        }
+        let mut line = self.frames.to_string();
+        for v in &state {
+            line.push_str(&format!(",{v}"));
+        }
+        line.push_str(&format!(
+            ",{},{},{},{},{}",
+            report.rms_px,
+            report.iterations,
+            report.features_found,
+            report.features_expected,
+            u8::from(report.lost)
+        ));
+        self.line(&line)?;
+        self.frames += 1;
+        Ok(())
+    }
+
+    /// Flushes the file; returns the number of rows written.
+    pub fn finish(mut self) -> Result<usize> {
+        self.out
+            .flush()
+            .with_context(|| format!("cannot write {}", self.path.display()))?;
+        Ok(self.frames)
+    }
+
+    fn line(&mut self, line: &str) -> Result<()> {
+        writeln!(self.out, "{line}")
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn truth_round_trips() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("truth.csv");
+        let rows = vec![vec![1.0, 0.0, 0.0, 0.0, 1.5, -2.25, 600.0, 0.125]; 3];
+        write_truth(&path, &rows).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.starts_with("frame,q0,q1,q2,q3,q4,q5,q6,q7\n0,1,0,0,0,1.5,-2.25,600,0.125\n"));
+        let table = read_states(&path, 8).unwrap();
+        assert_eq!(table.rows, rows);
+        assert!(table.extra_columns.is_empty());
+    }
+
+    #[test]
+    fn output_csv_has_the_documented_columns() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("states.csv");
+        let mut w = StatesWriter::create(&path, 8).unwrap();
+        let report = FrameReport {
+            rms_px: 0.75,
+            features_found: 30,
+            features_expected: 35,
+            iterations: 6,
+            lost: true,
+            ..FrameReport::default()
+        };
+        w.write(&[2.0, 0.0, 0.0, 0.0, 1.0, 2.0, 3.0, 0.5], &report)
+            .unwrap();
+        w.write(
+            &[0.0, 0.6, 0.8, 0.0, 1.0, 2.0, 3.0, 0.5],
+            &FrameReport::default(),
+        )
+        .unwrap();
+        assert_eq!(w.finish().unwrap(), 2);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(
+            lines[0],
+            "frame,q0,q1,q2,q3,q4,q5,q6,q7,rms_px,iterations,features_found,features_expected,lost"
+        );
+        // The quaternion is written unit length.
+        assert_eq!(lines[1], "0,1,0,0,0,1,2,3,0.5,0.75,6,30,35,1");
+        assert_eq!(lines[2], "1,0,0.6,0.8,0,1,2,3,0.5,0,0,0,0,0");
+        let table = parse_states(&text, 8).unwrap();
+        assert_eq!(table.extra_columns, REPORT_COLUMNS);
+        assert_eq!(table.extra("lost").unwrap(), vec![1.0, 0.0]);
+        let q = &table.rows[1];
+        let norm = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+        assert!((norm - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn malformed_tables_are_rejected_with_the_line() {
+        let err = |text: &str| format!("{:#}", parse_states(text, 2).unwrap_err());
+        assert!(err("").contains("empty"));
+        assert!(err("frame,q0\n0,1\n").contains("1 state columns"));
+        assert!(err("time,q0,q1\n").contains("header"));
+        assert!(err("frame,q0,q1\n0,1\n").contains("line 2"));
+        assert!(err("frame,q0,q1\n1,1,2\n").contains("expected frame 0"));
+        assert!(err("frame,q0,q1\n0,1,x\n").contains("q1"));
+        assert!(err("frame,q0,q1\n0,1,2\n1,1,nan\n").contains("line 3"));
+    }
+}
