@@ -1,0 +1,96 @@
+//! Runs the tracker over a fixed number of frames and iterations, for instruction counting
+//! under callgrind (`scripts/bench-instructions` drives it).
+//!
+//! ```text
+//! cargo run --release -p digiteyes-host --example stage_costs -- fullhand-mono /tmp/seq
+//! valgrind --tool=callgrind --toggle-collect='digiteyes_core::tracker::Tracker::track' \
+//!     target/release/examples/stage_costs fullhand-mono /tmp/seq
+//! ```
+//!
+//! The tracker starts at the truth of frame 0 and tracks frames 1..=FRAMES. By default
+//! every frame runs exactly ITERATIONS iterations (convergence test off), so the cost of
+//! `Tracker::track` divided by the iterations printed is the cost of one iteration; with
+//! `--converge` the default stopping rule applies and the cost per frame is the figure.
+//! If SEQ_DIR holds no sequence (or too few frames), SCENARIO is rendered into it first
+//! (seed 1); nothing before or after the `track` calls is counted with `--toggle-collect`.
+//!
+//! Prints one line of `key=value` pairs for the script to read.
+
+#[path = "../benches/support/mod.rs"]
+mod support;
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use anyhow::{ensure, Result};
+use clap::Parser;
+use digiteyes_host::TrackerConfig;
+
+use support::{render_if_missing, Case, Stages};
+
+#[derive(Parser)]
+#[command(about = "Track a fixed number of frames x iterations, for callgrind")]
+struct Args {
+    /// Scenario rendered into SEQ_DIR if it holds no sequence yet (mouse, fullhand-mono, ...).
+    scenario: String,
+    /// Sequence folder.
+    seq_dir: PathBuf,
+    /// Frames tracked (1..=FRAMES; frame 0 is the start).
+    #[arg(long, default_value_t = 4)]
+    frames: usize,
+    /// Iterations per frame.
+    #[arg(long, default_value_t = TrackerConfig::default().iterations)]
+    iterations: u8,
+    /// Stop iterating at convergence (the tracker's default rule) instead of running all.
+    #[arg(long)]
+    converge: bool,
+}
+
+fn main() -> Result<()> {
+    let args = Args::parse();
+    ensure!(args.frames >= 1, "track at least one frame");
+    render_if_missing(&args.scenario, &args.seq_dir, args.frames + 1)?;
+    let case = Case::load(&args.seq_dir, Some(args.frames + 1))?;
+
+    let mut config = TrackerConfig::default();
+    config.iterations = args.iterations;
+    if !args.converge {
+        config.converged_rad = 0.0;
+        config.converged_mm = 0.0;
+    }
+    let mut tracker = case.tracker(config)?;
+
+    let (mut iterations, mut lost, mut found, mut rows) = (0u64, 0u32, 0u64, 0u64);
+    let mut rms = 0.0f64;
+    let mut wall = Duration::ZERO;
+    for k in 1..=args.frames {
+        let frames = case.views(k);
+        let t0 = Instant::now();
+        let report = tracker.track(&frames)?;
+        wall += t0.elapsed();
+        iterations += u64::from(report.iterations);
+        lost += u32::from(report.lost);
+        found += u64::from(report.features_found);
+        rms += f64::from(report.rms_px);
+        // Rows of one iteration at the frame's result, stage by stage (outside `track`, so
+        // not counted): the residual rows the estimator stacks per iteration.
+        let state = tracker.state().to_vec();
+        let mut stages = Stages::new(&tracker, &state);
+        rows += u64::from(stages.iterate(&state, &frames).0);
+    }
+    let n = args.frames as f64;
+    println!(
+        "stage_costs scenario={} cameras={} frames={} iterations={} rows_per_iteration={:.1} \
+         features_found={:.1} lost={} mean_rms_px={:.3} wall_us_per_iteration={:.1}",
+        args.scenario,
+        case.cameras().len(),
+        args.frames,
+        iterations,
+        rows as f64 / n,
+        found as f64 / n,
+        lost,
+        rms / n,
+        wall.as_secs_f64() * 1e6 / iterations.max(1) as f64,
+    );
+    Ok(())
+}
