@@ -122,20 +122,31 @@ fn fingertip_camera() -> CameraFile {
     look_at("cam0", eye, target, [0.0, 0.0, 1.0])
 }
 
+/// Fingers point up the image.
+const FINGERS_UP: [f64; 3] = [0.0, 1.0, 0.0];
+/// The hand lies across the (landscape) image, fingers right, thumb down.
+const THUMB_DOWN: [f64; 3] = [-1.0, 0.0, 0.0];
+
 /// Where the facing cameras look: the middle of the hand at rest (palm frame, mm).
 const FACING_TARGET: [f64; 3] = [8.0, 50.0, 0.0];
 
 /// A camera on the palm side, `azimuth` rad around the palm's y axis (towards finger 1 for
 /// positive angles) and `elevation` rad towards the fingertips (below the wrist if negative),
-/// `distance` mm from [`FACING_TARGET`].
-fn facing_camera(name: &str, azimuth: f64, elevation: f64, distance: f64) -> CameraFile {
+/// `distance` mm from [`FACING_TARGET`], with world direction `up` pointing up the image.
+fn facing_camera(
+    name: &str,
+    azimuth: f64,
+    elevation: f64,
+    distance: f64,
+    up: [f64; 3],
+) -> CameraFile {
     let [tx, ty, tz] = FACING_TARGET;
     let eye = [
         tx + distance * elevation.cos() * azimuth.sin(),
         ty + distance * elevation.sin(),
         tz + distance * elevation.cos() * azimuth.cos(),
     ];
-    look_at(name, eye, FACING_TARGET, [0.0, 1.0, 0.0])
+    look_at(name, eye, [tx, ty, tz], up)
 }
 
 /// A pose of the facing set-up: palm at the origin, fingers spread (abduction of fingers
@@ -225,10 +236,10 @@ pub fn scenario(name: &str) -> Result<Scenario> {
         "rigid" => Scenario {
             name: "rigid",
             summary: "palm pose only (q0..q6): ±20° rotation, ±30 mm translation; fingers fixed",
-            cameras: vec![facing_camera("cam0", 35.0 * DEG, 20.0 * DEG, 550.0)],
+            cameras: vec![facing_camera("cam0", 35.0 * DEG, 20.0 * DEG, 520.0, THUMB_DOWN)],
             base: facing_pose([-0.12, -0.04, 0.04, 0.12], [0.15, 0.2, 0.1]),
             free: (0..7).collect(),
-            amplitudes: vec![(4, 30.0), (5, 30.0), (6, 30.0)],
+            amplitudes: vec![(4, 30.0), (5, 30.0), (6, 20.0)],
             rotation: Some([20.0 * DEG, 20.0 * DEG, 20.0 * DEG]),
             peak_tip_speed: 6.0,
             noise: 2.0,
@@ -270,14 +281,14 @@ pub fn scenario(name: &str) -> Result<Scenario> {
             "fullhand-stereo",
             "all 28 states move; two cameras 35° apart face the palm",
             vec![
-                facing_camera("cam0", -17.5 * DEG, -8.5 * DEG, 650.0),
-                facing_camera("cam1", 17.5 * DEG, -8.5 * DEG, 650.0),
+                facing_camera("cam0", -17.5 * DEG, -8.5 * DEG, 650.0, FINGERS_UP),
+                facing_camera("cam1", 17.5 * DEG, -8.5 * DEG, 650.0, FINGERS_UP),
             ],
         ),
         "fullhand-mono" => fullhand(
             "fullhand-mono",
             "the fullhand-stereo motion seen by its first camera only",
-            vec![facing_camera("cam0", -17.5 * DEG, -8.5 * DEG, 650.0)],
+            vec![facing_camera("cam0", -17.5 * DEG, -8.5 * DEG, 650.0, FINGERS_UP)],
         ),
         other => bail!(
             "unknown scenario `{other}`; scenarios are: {}",

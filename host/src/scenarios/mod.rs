@@ -2,8 +2,9 @@
 //!
 //! A scenario ([`catalogue`]) fixes the cameras, the base pose, which states are free and how
 //! far they move. [`generate`] draws a smooth seeded trajectory ([`trajectory`]), scales its
-//! speed so the fastest fingertip peaks at the scenario's image speed, checks the hand stays
-//! in view, and [`render_scenario`] writes `sequence.json` (`model: "builtin:hand"`), the
+//! speed so the fastest fingertip peaks at the scenario's image speed (in the first camera),
+//! checks the hand stays in view (shrinking the amplitudes for the rare seed whose motion would
+//! leave it), and [`render_scenario`] writes `sequence.json` (`model: "builtin:hand"`), the
 //! frames and `truth.csv` (every state, every frame).
 
 pub mod cameras;
@@ -28,6 +29,11 @@ pub const DEFAULT_FRAMES: usize = 60;
 pub const FPS: f64 = 30.0;
 /// The hand keeps at least this far from the image border (px).
 pub const VIEW_MARGIN_PX: f32 = 2.0;
+/// When a seed's motion would leave the view, its amplitudes shrink by this factor, again and
+/// again down to [`MIN_SHRINK`], until the hand stays in view (deterministic per seed).
+pub const SHRINK_STEP: f64 = 0.9;
+/// The smallest fraction of a scenario's amplitudes tried before giving up.
+pub const MIN_SHRINK: f64 = 0.5;
 
 /// Options of [`render_scenario`]; `None` fields take the scenario's own setting.
 #[derive(Debug, Clone, PartialEq)]
@@ -81,6 +87,9 @@ pub struct Generated {
     pub settings: RenderSettings,
     /// Time scale of the trajectory (τ per frame).
     pub time_scale: f64,
+    /// Fraction of the scenario's amplitudes used (below 1 when the full motion would have
+    /// left the view for this seed).
+    pub amplitude_factor: f64,
 }
 
 /// Draws the trajectory of scenario `name` and everything else needed to render it.
@@ -90,25 +99,10 @@ pub fn generate(name: &str, opts: &RenderOptions) -> Result<Generated> {
     let scenario = catalogue::scenario(name)?;
     let model = Model::hand().map_err(|e| anyhow::anyhow!("built-in hand model: {e}"))?;
     let amplitudes = within_limits(&model, &scenario.base, &scenario.amplitudes);
-    let motion = Motion::random(
-        scenario.base.clone(),
-        &amplitudes,
-        scenario.rotation,
-        opts.seed,
-    );
     // Speed is set in the first camera at the default size, so the motion depends neither on
     // the image size nor on further cameras (`fullhand-mono` moves as `fullhand-stereo`).
-    let full_size = sequence::check_cameras(&scenario.cameras[..1])?;
-    let horizon = frames.max(DEFAULT_FRAMES);
-    let time_scale = calibrate_speed(
-        &model,
-        &full_size,
-        &motion,
-        horizon,
-        scenario.peak_tip_speed,
-    )
-    .with_context(|| format!("scenario {name}"))?;
-    let truth = motion.sample(frames, time_scale);
+    let full_size = sequence::check_cameras(&scenario.cameras)?;
+    let reference = &full_size[..1];
     let camera_files: Vec<CameraFile> = match opts.size {
         Some((w, h)) => scenario
             .cameras
@@ -118,8 +112,29 @@ pub fn generate(name: &str, opts: &RenderOptions) -> Result<Generated> {
         None => scenario.cameras.clone(),
     };
     let cameras = sequence::check_cameras(&camera_files)?;
-    measure::check_in_view(&model, &cameras, &truth, VIEW_MARGIN_PX)
-        .with_context(|| format!("scenario {name}, seed {}", opts.seed))?;
+    let horizon = frames.max(DEFAULT_FRAMES);
+    let mut shrink = 1.0;
+    let (truth, time_scale, amplitude_factor) = loop {
+        let motion = Motion::random(
+            scenario.base.clone(),
+            &amplitudes,
+            scenario.rotation,
+            opts.seed,
+        )
+        .scaled(shrink);
+        let time_scale =
+            calibrate_speed(&model, reference, &motion, horizon, scenario.peak_tip_speed)
+                .with_context(|| format!("scenario {name}"))?;
+        // The view is checked at the default size, so every size shows the same motion.
+        let truth = motion.sample(horizon, time_scale);
+        match measure::check_in_view(&model, &full_size, &truth, VIEW_MARGIN_PX) {
+            Ok(()) => break (motion.sample(frames, time_scale), time_scale, shrink),
+            Err(e) if shrink <= MIN_SHRINK => {
+                return Err(e.context(format!("scenario {name}, seed {}", opts.seed)))
+            }
+            Err(_) => shrink *= SHRINK_STEP,
+        }
+    };
     let file = SequenceFile {
         model: BUILTIN_HAND.to_string(),
         fps: Some(FPS),
@@ -148,6 +163,7 @@ pub fn generate(name: &str, opts: &RenderOptions) -> Result<Generated> {
         truth,
         settings,
         time_scale,
+        amplitude_factor,
     })
 }
 

@@ -77,6 +77,19 @@ impl Motion {
         }
     }
 
+    /// The same motion with every amplitude multiplied by `factor`.
+    pub fn scaled(mut self, factor: f64) -> Motion {
+        for (_, amplitude, _) in &mut self.states {
+            *amplitude *= factor;
+        }
+        if let Some(rotation) = &mut self.rotation {
+            for (amplitude, _) in rotation.iter_mut() {
+                *amplitude *= factor;
+            }
+        }
+        self
+    }
+
     /// The state at time `tau` (quaternion unit length, mm, rad).
     pub fn at(&self, tau: f64) -> Vec<f64> {
         let mut q = self.base.clone();
