@@ -29,6 +29,10 @@ pub enum ResidualKind {
     EdgePoints,
     /// Two rows per link: the model axis' end points against the fitted axis line (Eq. 2.17).
     AxisLines,
+    /// One row per slice: where both edges were found, the distance of their midpoint from the
+    /// model axis (blind to a width bias, such as shading pulling both edges inward); a lone
+    /// edge gives its edge-point row.
+    AxisPoints,
 }
 
 /// Robust weighting of residuals (px).
@@ -108,7 +112,7 @@ pub struct EstimatorConfig {
 impl Default for EstimatorConfig {
     fn default() -> Self {
         EstimatorConfig {
-            residual: ResidualKind::EdgePoints,
+            residual: ResidualKind::AxisPoints,
             robust: Robust::Huber(2.0),
             conditioning: Conditioning {
                 quaternion: 1.0,
@@ -325,6 +329,34 @@ pub fn add_link_rows(
         ResidualKind::EdgePoints => {
             for e in &features.edges {
                 let r = edge_row(link, jac, e, &mut row);
+                ne.add_row(&row, r, config.robust.weight(r), free);
+                added.edges += 1;
+            }
+        }
+        ResidualKind::AxisPoints => {
+            let mut pair = Row::new();
+            let edges = &features.edges;
+            let mut i = 0;
+            while i < edges.len() {
+                let e = &edges[i];
+                let partner = edges
+                    .get(i + 1)
+                    .filter(|o| o.side == -e.side && (o.s - e.s).abs() < 1e-6);
+                let r = match partner {
+                    Some(o) => {
+                        let r_plus = edge_row(link, jac, e, &mut row);
+                        let r_minus = edge_row(link, jac, o, &mut pair);
+                        for (a, b) in row.iter_mut().zip(pair.iter()) {
+                            a.1 = 0.5 * (a.1 - b.1) * f32::from(e.side);
+                        }
+                        i += 2;
+                        0.5 * (r_plus - r_minus) * f32::from(e.side)
+                    }
+                    None => {
+                        i += 1;
+                        edge_row(link, jac, e, &mut row)
+                    }
+                };
                 ne.add_row(&row, r, config.robust.weight(r), free);
                 added.edges += 1;
             }

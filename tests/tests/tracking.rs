@@ -4,13 +4,19 @@
 
 use std::path::{Path, PathBuf};
 
-use digiteyes_host::{evaluate, render_scenario, track_sequence, EvalReport, RenderOptions, TrackerConfig};
+use digiteyes_host::{
+    evaluate, render_scenario, track_sequence, EvalReport, RenderOptions, TrackerConfig,
+};
 
 /// Renders `scenario` (`frames` frames), tracks it with the default tracker, and evaluates.
 fn run(scenario: &str, frames: usize) -> EvalReport {
     let dir = tempfile::tempdir().unwrap();
     let seq = dir.path().join(scenario);
-    let options = RenderOptions { seed: 1, frames: Some(frames), ..RenderOptions::default() };
+    let options = RenderOptions {
+        seed: 1,
+        frames: Some(frames),
+        ..RenderOptions::default()
+    };
     render_scenario(scenario, &seq, &options).unwrap();
     let states = dir.path().join("states.csv");
     let summary = track_sequence(&seq, &states, TrackerConfig::default(), false).unwrap();
@@ -21,13 +27,21 @@ fn run(scenario: &str, frames: usize) -> EvalReport {
 }
 
 fn fingertip_mean(report: &EvalReport) -> f64 {
-    report.cameras.iter().map(|c| c.fingertip_mean_px).fold(0.0, f64::max)
+    report
+        .cameras
+        .iter()
+        .map(|c| c.fingertip_mean_px)
+        .fold(0.0, f64::max)
 }
 
 #[test]
 fn mouse_tracks_to_a_pixel_and_a_few_degrees() {
     let r = run("mouse", 30);
-    assert!(fingertip_mean(&r) < 1.5, "fingertip error {} px", fingertip_mean(&r));
+    assert!(
+        fingertip_mean(&r) < 1.5,
+        "fingertip error {} px",
+        fingertip_mean(&r)
+    );
     assert!(r.joint_rms_deg < 3.0, "free-joint RMS {}°", r.joint_rms_deg);
     assert_eq!(r.track_life, 1.0);
 }
@@ -35,14 +49,26 @@ fn mouse_tracks_to_a_pixel_and_a_few_degrees() {
 #[test]
 fn rigid_palm_pose() {
     let r = run("rigid", 30);
-    assert!(r.palm_rotation_deg < 1.5, "palm rotation error {}°", r.palm_rotation_deg);
-    assert!(r.palm_translation_mm < 3.0, "palm translation error {} mm", r.palm_translation_mm);
+    assert!(
+        r.palm_rotation_deg < 1.5,
+        "palm rotation error {}°",
+        r.palm_rotation_deg
+    );
+    assert!(
+        r.palm_translation_mm < 3.0,
+        "palm translation error {} mm",
+        r.palm_translation_mm
+    );
 }
 
 #[test]
 fn fullhand_stereo() {
     let r = run("fullhand-stereo", 20);
-    assert!(fingertip_mean(&r) < 2.0, "fingertip error {} px", fingertip_mean(&r));
+    assert!(
+        fingertip_mean(&r) < 2.0,
+        "fingertip error {} px",
+        fingertip_mean(&r)
+    );
     assert!(r.joint_rms_deg < 5.0, "free-joint RMS {}°", r.joint_rms_deg);
     assert_eq!(r.track_life, 1.0);
 }
@@ -50,13 +76,23 @@ fn fullhand_stereo() {
 #[test]
 fn fast_motion_keeps_track() {
     let r = run("fast", 30);
-    assert_eq!(r.track_life, 1.0, "fingertip error {} px", fingertip_mean(&r));
+    assert_eq!(
+        r.track_life,
+        1.0,
+        "fingertip error {} px",
+        fingertip_mean(&r)
+    );
 }
 
 #[test]
 fn clutter_keeps_track() {
     let r = run("clutter", 30);
-    assert_eq!(r.track_life, 1.0, "fingertip error {} px", fingertip_mean(&r));
+    assert_eq!(
+        r.track_life,
+        1.0,
+        "fingertip error {} px",
+        fingertip_mean(&r)
+    );
 }
 
 /// The conformance sample from an independent renderer: if we read the contract (PGM, camera
@@ -66,7 +102,10 @@ fn clutter_keeps_track() {
 fn the_independent_sample_mouse_fixture_tracks_to_a_pixel() {
     let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/fixtures/sample-mouse");
     if !fixture.exists() {
-        panic!("fixture missing at {}: the repository must be checked out beside shared/", fixture.display());
+        panic!(
+            "fixture missing at {}: the repository must be checked out beside shared/",
+            fixture.display()
+        );
     }
     let dir = tempfile::tempdir().unwrap();
     let states: PathBuf = dir.path().join("states.csv");
@@ -74,7 +113,11 @@ fn the_independent_sample_mouse_fixture_tracks_to_a_pixel() {
     assert_eq!(summary.frames, 12);
     let r = evaluate(&fixture, &states).unwrap();
     println!("sample-mouse: {r:#?}");
-    assert!(fingertip_mean(&r) < 1.0, "fingertip error {} px", fingertip_mean(&r));
+    assert!(
+        fingertip_mean(&r) < 1.0,
+        "fingertip error {} px",
+        fingertip_mean(&r)
+    );
     assert!(r.joint_rms_deg < 3.0, "free-joint RMS {}°", r.joint_rms_deg);
     assert_eq!(r.track_life, 1.0);
 }
