@@ -79,8 +79,8 @@ enum Command {
     Track {
         /// Sequence folder.
         seqdir: PathBuf,
-        /// Output CSV path.
-        #[arg(long, short, default_value = "states.csv")]
+        /// Output CSV path (default: states.csv in the current folder).
+        #[arg(long, short, default_value = "states.csv", hide_default_value = true)]
         out: PathBuf,
         /// Gauss–Newton iterations per frame (default: the tracker's).
         #[arg(long, value_parser = clap::value_parser!(u8).range(1..))]

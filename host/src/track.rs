@@ -32,6 +32,8 @@ pub struct TrackSummary {
     pub total_seconds: f64,
     /// Where the states were written.
     pub out: PathBuf,
+    /// The sequence's frame rate (frames/s), when `sequence.json` gives one.
+    pub fps: Option<f64>,
 }
 
 impl TrackSummary {
@@ -48,13 +50,21 @@ impl fmt::Display for TrackSummary {
             "tracked {} frames x {} camera(s): {} lost, mean rms {:.3} px",
             self.frames, self.cameras, self.lost_frames, self.mean_rms_px
         )?;
-        writeln!(
+        write!(
             f,
             "tracker time {:.3} s ({:.1} frames/s), total {:.3} s",
             self.tracking_seconds,
             self.frames_per_second(),
             self.total_seconds
         )?;
+        match self.fps {
+            Some(fps) if fps > 0.0 => writeln!(
+                f,
+                "; {:.2}x real time at the sequence's {fps} frames/s",
+                self.frames_per_second() / fps
+            )?,
+            _ => writeln!(f)?,
+        }
         write!(f, "states written to {}", self.out.display())
     }
 }
@@ -123,5 +133,6 @@ pub fn track_sequence(
         tracking_seconds: tracking.as_secs_f64(),
         total_seconds: start.elapsed().as_secs_f64(),
         out: out_csv.to_path_buf(),
+        fps: sequence.fps(),
     })
 }

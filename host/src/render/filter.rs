@@ -43,12 +43,12 @@ pub fn gaussian_blur(img: &mut [f32], width: usize, height: usize, sigma: f32) {
 /// Adds zero-mean Gaussian noise of standard deviation `sigma` (grey levels), drawn from
 /// `seed`. No-op for `sigma <= 0`.
 pub fn add_noise(img: &mut [f32], sigma: f32, seed: u64) {
+    if sigma.is_nan() || sigma <= 0.0 {
+        return;
+    }
     let Ok(normal) = Normal::new(0.0f32, sigma) else {
         return;
     };
-    if sigma <= 0.0 {
-        return;
-    }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     for v in img.iter_mut() {
         *v += normal.sample(&mut rng);
