@@ -200,8 +200,11 @@ fn run(cli: Cli) -> Result<()> {
             let result = run_demo(frames, keep.as_deref(), TrackerConfig::default(), progress)?;
             println!("{}", result.track);
             print!("{}", result.eval);
-            if keep.is_some() {
-                println!("sequence kept in {}", result.sequence.display());
+            match keep {
+                Some(_) => println!("sequence kept in {}", result.sequence.display()),
+                None => println!(
+                    "(the sequence was in a temporary folder, now removed; --keep DIR keeps it)"
+                ),
             }
         }
     }

@@ -116,9 +116,7 @@ impl Sequence {
     /// Reads frame `frame` of camera `cam`, checking it is 8-bit `P5` of the camera's size.
     pub fn read_frame(&self, cam: usize, frame: usize) -> Result<GrayImage> {
         let path = self.frame_path(cam, frame);
-        let image = pgm::read_pgm(&path)?;
-        self.check_size(cam, &path, image.dimensions())?;
-        Ok(image)
+        pgm::read_pgm_checked(&path, |size| self.check_size(cam, &path, size))
     }
 
     /// Reads the header of every frame: each must be 8-bit `P5` of its camera's size.

@@ -18,8 +18,18 @@ pub fn read_pgm_size(path: &Path) -> Result<(u32, u32)> {
 
 /// Reads a binary 8-bit PGM (`P5`, maxval 255).
 pub fn read_pgm(path: &Path) -> Result<GrayImage> {
+    read_pgm_checked(path, |_| Ok(()))
+}
+
+/// Reads a binary 8-bit PGM after `check` has accepted its width and height (px), so a
+/// header announcing a huge image is refused before any pixel memory is allocated.
+pub fn read_pgm_checked(
+    path: &Path,
+    check: impl FnOnce((u32, u32)) -> Result<()>,
+) -> Result<GrayImage> {
     let decoder = open_decoder(path)?;
     let (width, height) = decoder.dimensions();
+    check((width, height))?;
     let mut pixels = vec![0u8; decoder.total_bytes() as usize];
     decoder
         .read_image(&mut pixels)
