@@ -63,10 +63,14 @@ pub fn rotation_derivatives(q: [f32; 4], v: &Vector3<f32>) -> Option<[Vector3<f3
     Some(out)
 }
 
-/// Angle in radians between two unit quaternions' rotations (sign-invariant).
+/// Angle in radians between two unit quaternions' rotations (sign-invariant): `2·atan2(|v|, |w|)`
+/// of the relative rotation `a⁻¹ b`, exact near zero where `acos` of the dot product is not.
 pub fn angle_between(a: [f32; 4], b: [f32; 4]) -> f32 {
-    let d = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]).abs();
-    2.0 * libm::acosf(d.min(1.0))
+    let (aw, av) = (a[0], Vector3::new(a[1], a[2], a[3]));
+    let (bw, bv) = (b[0], Vector3::new(b[1], b[2], b[3]));
+    let w = aw * bw + av.dot(&bv);
+    let v = bv * aw - av * bw - av.cross(&bv);
+    2.0 * libm::atan2f(v.norm(), w.abs())
 }
 
 /// The unit quaternion `(w, x, y, z)` of a rotation matrix (Shepperd's method).

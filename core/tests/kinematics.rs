@@ -561,3 +561,24 @@ fn dh_transform_matches_its_definition() {
     let y = rx.apply(&Vector3::y());
     assert!((y - Vector3::new(0.0, (-1.1f32).cos(), (-1.1f32).sin())).norm() < 1e-6);
 }
+
+#[test]
+fn angle_between_is_exact_for_small_and_large_turns() {
+    use digiteyes_core::quaternion::angle_between;
+    for &angle in &[1e-4f32, 0.01, 0.5, 3.0] {
+        let (s, c) = (angle * 0.5).sin_cos();
+        let a = [0.6f32, 0.0, 0.8, 0.0];
+        // b = a · (turn about x by `angle`)
+        let t = [c, s, 0.0, 0.0];
+        let b = [
+            a[0] * t[0] - a[1] * t[1] - a[2] * t[2] - a[3] * t[3],
+            a[0] * t[1] + a[1] * t[0] + a[2] * t[3] - a[3] * t[2],
+            a[0] * t[2] - a[1] * t[3] + a[2] * t[0] + a[3] * t[1],
+            a[0] * t[3] + a[1] * t[2] - a[2] * t[1] + a[3] * t[0],
+        ];
+        let got = angle_between(a, b);
+        assert!((got - angle).abs() < 1e-3 * angle + 1e-6, "{angle}: {got}");
+        let neg = [-b[0], -b[1], -b[2], -b[3]];
+        assert!((angle_between(a, neg) - got).abs() < 1e-6, "sign-invariant");
+    }
+}
