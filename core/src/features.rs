@@ -105,21 +105,26 @@ pub fn find_edge(profile: &[f32], polarity: Polarity, min_contrast: f32) -> Opti
         }
     }
     let (k, strength) = best?;
-    let (l, c, r) = (
+    let offset = vertex_offset(
         oriented(derivative[k - 1]),
         strength,
         oriented(derivative[k + 1]),
     );
-    let curvature = l - 2.0 * c + r;
-    let offset = if curvature < -1e-6 {
-        (0.5 * (l - r) / curvature).clamp(-0.5, 0.5)
-    } else {
-        0.0
-    };
     Some(Edge {
         position: k as f32 + offset,
         strength,
     })
+}
+
+/// Sub-sample offset (−0.5..0.5) of the vertex of the parabola through three samples one
+/// apart, `l`, `c`, `r`, with `c` the extremum; 0 when they are collinear.
+fn vertex_offset(l: f32, c: f32, r: f32) -> f32 {
+    let curvature = l - 2.0 * c + r;
+    if curvature.abs() > 1e-6 {
+        (0.5 * (l - r) / curvature).clamp(-0.5, 0.5)
+    } else {
+        0.0
+    }
 }
 
 /// Finds the boundary between two touching bright surfaces in `profile`: the deepest intensity
@@ -149,13 +154,7 @@ pub fn find_valley(profile: &[f32], min_depth: f32) -> Option<Edge> {
         }
     }
     let (k, strength) = best?;
-    let (l, c, r) = (smooth[k - 1], smooth[k], smooth[k + 1]);
-    let curvature = l - 2.0 * c + r;
-    let offset = if curvature > 1e-6 {
-        (0.5 * (l - r) / curvature).clamp(-0.5, 0.5)
-    } else {
-        0.0
-    };
+    let offset = vertex_offset(smooth[k - 1], smooth[k], smooth[k + 1]);
     Some(Edge {
         position: k as f32 + offset,
         strength,

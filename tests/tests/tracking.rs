@@ -26,6 +26,11 @@ fn run(scenario: &str, frames: usize) -> EvalReport {
     report
 }
 
+/// Fails with the figure and its unit when `value` is not below `bar`.
+fn below(value: f64, bar: f64, what: &str) {
+    assert!(value < bar, "{what}: {value} is not below {bar}");
+}
+
 fn fingertip_mean(report: &EvalReport) -> f64 {
     report
         .cameras
@@ -37,39 +42,23 @@ fn fingertip_mean(report: &EvalReport) -> f64 {
 #[test]
 fn mouse_tracks_to_a_pixel_and_a_few_degrees() {
     let r = run("mouse", 30);
-    assert!(
-        fingertip_mean(&r) < 1.5,
-        "fingertip error {} px",
-        fingertip_mean(&r)
-    );
-    assert!(r.joint_rms_deg < 3.0, "free-joint RMS {}°", r.joint_rms_deg);
+    below(fingertip_mean(&r), 1.5, "fingertip error (px)");
+    below(r.joint_rms_deg, 3.0, "free-joint RMS (deg)");
     assert_eq!(r.track_life, 1.0);
 }
 
 #[test]
 fn rigid_palm_pose() {
     let r = run("rigid", 30);
-    assert!(
-        r.palm_rotation_deg < 1.5,
-        "palm rotation error {}°",
-        r.palm_rotation_deg
-    );
-    assert!(
-        r.palm_translation_mm < 3.0,
-        "palm translation error {} mm",
-        r.palm_translation_mm
-    );
+    below(r.palm_rotation_deg, 1.5, "palm rotation error (deg)");
+    below(r.palm_translation_mm, 3.0, "palm translation error (mm)");
 }
 
 #[test]
 fn fullhand_stereo() {
     let r = run("fullhand-stereo", 20);
-    assert!(
-        fingertip_mean(&r) < 2.0,
-        "fingertip error {} px",
-        fingertip_mean(&r)
-    );
-    assert!(r.joint_rms_deg < 5.0, "free-joint RMS {}°", r.joint_rms_deg);
+    below(fingertip_mean(&r), 2.0, "fingertip error (px)");
+    below(r.joint_rms_deg, 5.0, "free-joint RMS (deg)");
     assert_eq!(r.track_life, 1.0);
 }
 
@@ -113,11 +102,7 @@ fn the_independent_sample_mouse_fixture_tracks_to_a_pixel() {
     assert_eq!(summary.frames, 12);
     let r = evaluate(&fixture, &states).unwrap();
     println!("sample-mouse: {r:#?}");
-    assert!(
-        fingertip_mean(&r) < 1.0,
-        "fingertip error {} px",
-        fingertip_mean(&r)
-    );
-    assert!(r.joint_rms_deg < 3.0, "free-joint RMS {}°", r.joint_rms_deg);
+    below(fingertip_mean(&r), 1.0, "fingertip error (px)");
+    below(r.joint_rms_deg, 3.0, "free-joint RMS (deg)");
     assert_eq!(r.track_life, 1.0);
 }
