@@ -240,18 +240,28 @@ impl NormalEquations {
         if w == 0.0 {
             return;
         }
-        for (i, &(si, vi)) in entries.iter().enumerate() {
-            let si = usize::from(si);
-            if !free.contains(si) || si >= MAX_STATES {
-                continue;
+        // Keep the free entries once, then a plain rank-1 update of the upper triangle.
+        let mut index = [0usize; MAX_ROW_NONZEROS];
+        let mut value = [0.0f32; MAX_ROW_NONZEROS];
+        let mut n = 0;
+        for &(s, v) in entries.iter().take(MAX_ROW_NONZEROS) {
+            let s = usize::from(s);
+            if s < MAX_STATES && free.contains(s) {
+                index[n] = s;
+                value[n] = v;
+                n += 1;
             }
-            let wv = w * vi;
-            self.jtr[si] += wv * r;
-            for &(sj, vj) in &entries[i..] {
-                let sj = usize::from(sj);
-                if free.contains(sj) && sj < MAX_STATES {
-                    let (lo, hi) = if si <= sj { (si, sj) } else { (sj, si) };
-                    self.jtj[(lo, hi)] += wv * vj;
+        }
+        let jtj = self.jtj.as_mut_slice();
+        for a in 0..n {
+            let (ia, wv) = (index[a], w * value[a]);
+            self.jtr[ia] += wv * r;
+            for b in a..n {
+                let ib = index[b];
+                let (lo, hi) = if ia <= ib { (ia, ib) } else { (ib, ia) };
+                // Column-major: element (lo, hi) of the upper triangle.
+                if let Some(cell) = jtj.get_mut(hi * MAX_STATES + lo) {
+                    *cell += wv * value[b];
                 }
             }
         }

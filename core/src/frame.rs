@@ -159,12 +159,38 @@ impl<'a> FrameView<'a> {
         if !(inside(start) && inside(end)) {
             return false;
         }
-        for (k, o) in out.iter_mut().enumerate() {
-            let p = start + step * k as f32;
-            match self.sample(p.x, p.y) {
-                Some(v) => *o = v,
-                None => return false,
+        if self.width < 2 || self.height < 2 {
+            for (k, o) in out.iter_mut().enumerate() {
+                let p = start + step * k as f32;
+                match self.sample(p.x, p.y) {
+                    Some(v) => *o = v,
+                    None => return false,
+                }
             }
+            return true;
+        }
+        // Both ends are inside, so every point between is: the hot loop of the slice search
+        // reads the 2×2 neighbourhood as two row pairs, with no per-point range checks.
+        let (xmax, ymax) = (self.width - 2, self.height - 2);
+        let (mut x, mut y) = (start.x, start.y);
+        for o in out.iter_mut() {
+            let x0 = (x as usize).min(xmax);
+            let y0 = (y as usize).min(ymax);
+            let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+            let i = y0 * self.stride + x0;
+            let (Some(top), Some(bottom)) = (
+                self.data.get(i..i + 2),
+                self.data.get(i + self.stride..i + self.stride + 2),
+            ) else {
+                return false;
+            };
+            let (t0, t1) = (f32::from(top[0]), f32::from(top[1]));
+            let (b0, b1) = (f32::from(bottom[0]), f32::from(bottom[1]));
+            let upper = t0 + (t1 - t0) * fx;
+            let lower = b0 + (b1 - b0) * fx;
+            *o = upper + (lower - upper) * fy;
+            x += step.x;
+            y += step.y;
         }
         true
     }
