@@ -223,8 +223,8 @@ impl NormalEquations {
 
     /// Clears for the next iteration.
     pub fn clear(&mut self) {
-        self.jtj.fill(0.0);
-        self.jtr.fill(0.0);
+        self.jtj = SMatrix::zeros();
+        self.jtr = SVector::zeros();
         self.sum_squares = 0.0;
         self.rows = 0;
     }
@@ -320,6 +320,160 @@ pub struct LinkRows {
     pub tips: u16,
 }
 
+/// Width of a link's dense block: [`MAX_ROW_NONZEROS`] rounded up to a multiple of 4, so the
+/// row loops have a fixed length the compiler turns into SIMD.
+const BLOCK: usize = MAX_ROW_NONZEROS.div_ceil(4) * 4;
+
+/// The normal equations of one link's rows over the link's own states (`jac.states`, at most
+/// [`MAX_ROW_NONZEROS`]): dense and small, added to the 32×32 system once per link.
+struct LinkBlock {
+    n: usize,
+    jtj: [[f32; BLOCK]; BLOCK],
+    jtr: [f32; BLOCK],
+    sum_squares: f32,
+    rows: u16,
+}
+
+impl LinkBlock {
+    fn new(n: usize) -> Self {
+        LinkBlock {
+            n: n.min(MAX_ROW_NONZEROS),
+            jtj: [[0.0; BLOCK]; BLOCK],
+            jtr: [0.0; BLOCK],
+            sum_squares: 0.0,
+            rows: 0,
+        }
+    }
+
+    /// As [`NormalEquations::add_row`], with `values[k]` the derivative by `jac.states[k]`
+    /// (entries from `n` on are zero).
+    fn add(&mut self, values: &[f32; BLOCK], r: f32, w: f32) {
+        let finite = values.iter().fold(true, |ok, v| ok & v.is_finite());
+        if !(r.is_finite() && w.is_finite() && finite) {
+            return;
+        }
+        self.sum_squares += r * r;
+        self.rows = self.rows.saturating_add(1);
+        if w == 0.0 {
+            return;
+        }
+        // The full square (not the triangle): fixed-length rows vectorise.
+        for (i, (row, rhs)) in self.jtj.iter_mut().zip(self.jtr.iter_mut()).enumerate() {
+            if i >= self.n {
+                break;
+            }
+            let wv = w * values[i];
+            *rhs += wv * r;
+            for (a, v) in row.iter_mut().zip(values) {
+                *a += wv * v;
+            }
+        }
+    }
+
+    /// Adds the block's upper triangle to `ne`, dropping states that are not free.
+    fn scatter(&self, ne: &mut NormalEquations, states: &[u8], free: FreeMask) {
+        ne.sum_squares += self.sum_squares;
+        ne.rows = ne.rows.saturating_add(self.rows);
+        for i in 0..self.n {
+            let si = usize::from(states[i]);
+            if !free.contains(si) || si >= MAX_STATES {
+                continue;
+            }
+            ne.jtr[si] += self.jtr[i];
+            for (j, &sj) in states.iter().enumerate().take(self.n).skip(i) {
+                let sj = usize::from(sj);
+                if free.contains(sj) && sj < MAX_STATES {
+                    let (lo, hi) = if si <= sj { (si, sj) } else { (sj, si) };
+                    ne.jtj[(lo, hi)] += self.jtj[i][j];
+                }
+            }
+        }
+    }
+
+    fn add_row(&mut self, row: &Row, r: f32, w: f32) {
+        let mut values = [0.0; BLOCK];
+        for (v, (_, d)) in values.iter_mut().zip(row.iter()) {
+            *v = *d;
+        }
+        self.add(&values, r, w);
+    }
+}
+
+/// What every edge row of one link shares (see [`edge_row`]), computed once per link: each
+/// row is then a fixed-length combination of these per-state vectors.
+struct EdgeBasis {
+    normal: Vector2<f32>,
+    axis: Vector2<f32>,
+    len2: f32,
+    taper: [f32; 2],
+    nda: [f32; BLOCK],
+    ndb: [f32; BLOCK],
+    dax: [f32; BLOCK],
+    day: [f32; BLOCK],
+    ds0: [f32; BLOCK],
+    ds1: [f32; BLOCK],
+    dr0: [f32; BLOCK],
+    dr1: [f32; BLOCK],
+}
+
+impl EdgeBasis {
+    fn new(link: &ProjectedLink, jac: &LinkJacobian) -> Self {
+        let (_, normal) = axis_frame(&link.a, &link.b);
+        let axis = link.b - link.a;
+        let mut b = EdgeBasis {
+            normal,
+            axis,
+            len2: axis.norm_squared().max(1e-9),
+            taper: [1i8, -1]
+                .map(|side| link.side_radius_at(1.0, side) - link.side_radius_at(0.0, side)),
+            nda: [0.0; BLOCK],
+            ndb: [0.0; BLOCK],
+            dax: [0.0; BLOCK],
+            day: [0.0; BLOCK],
+            ds0: [0.0; BLOCK],
+            ds1: [0.0; BLOCK],
+            dr0: [0.0; BLOCK],
+            dr1: [0.0; BLOCK],
+        };
+        for k in 0..jac.states.len().min(MAX_ROW_NONZEROS) {
+            let d_axis = jac.db[k] - jac.da[k];
+            b.nda[k] = normal.dot(&jac.da[k]);
+            b.ndb[k] = normal.dot(&jac.db[k]);
+            b.dax[k] = d_axis.x;
+            b.day[k] = d_axis.y;
+            b.ds0[k] = jac.da[k].dot(&axis);
+            b.ds1[k] = axis.dot(&d_axis);
+            b.dr0[k] = jac.dr0[k];
+            b.dr1[k] = jac.dr1[k];
+        }
+        b
+    }
+
+    /// [`edge_row`]'s derivatives (by `jac.states[k]`, zero beyond) and [`edge_residual`].
+    fn row(&self, link: &ProjectedLink, e: &EdgePoint) -> ([f32; BLOCK], f32) {
+        let rel = e.position - link.a;
+        let raw_s = rel.dot(&self.axis) / self.len2;
+        let s = raw_s.clamp(0.0, 1.0);
+        let side = f32::from(e.side);
+        let t = if (0.0..=1.0).contains(&raw_s) {
+            self.taper[usize::from(e.side < 0)] / self.len2
+        } else {
+            0.0
+        };
+        let mut values = [0.0f32; BLOCK];
+        for (k, v) in values.iter_mut().enumerate() {
+            let ds =
+                rel.x * self.dax[k] + rel.y * self.day[k] - self.ds0[k] - 2.0 * raw_s * self.ds1[k];
+            *v = side * ((1.0 - s) * self.nda[k] + s * self.ndb[k])
+                + (1.0 - s) * self.dr0[k]
+                + s * self.dr1[k]
+                + t * ds;
+        }
+        let r = link.side_radius_at(s, e.side) - side * self.normal.dot(&rel);
+        (values, r)
+    }
+}
+
 /// Adds the rows of one link's features to `ne`.
 #[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
 pub fn add_link_rows(
@@ -334,17 +488,20 @@ pub fn add_link_rows(
     if jac.states.is_empty() {
         return added;
     }
+    let n = jac.states.len().min(MAX_ROW_NONZEROS);
+    let mut block = LinkBlock::new(n);
     let mut row = Row::new();
     match config.residual {
         ResidualKind::EdgePoints => {
+            let basis = EdgeBasis::new(link, jac);
             for e in &features.edges {
-                let r = edge_row(link, jac, e, &mut row);
-                ne.add_row(&row, r, config.robust.weight(r), free);
+                let (values, r) = basis.row(link, e);
+                block.add(&values, r, config.robust.weight(r));
                 added.edges += 1;
             }
         }
         ResidualKind::AxisPoints => {
-            let mut pair = Row::new();
+            let basis = EdgeBasis::new(link, jac);
             let edges = &features.edges;
             let mut i = 0;
             while i < edges.len() {
@@ -352,22 +509,23 @@ pub fn add_link_rows(
                 let partner = edges
                     .get(i + 1)
                     .filter(|o| o.side == -e.side && (o.s - e.s).abs() < 1e-6);
-                let r = match partner {
+                let (values, r) = match partner {
                     Some(o) => {
-                        let r_plus = edge_row(link, jac, e, &mut row);
-                        let r_minus = edge_row(link, jac, o, &mut pair);
-                        for (a, b) in row.iter_mut().zip(pair.iter()) {
-                            a.1 = 0.5 * (a.1 - b.1) * f32::from(e.side);
+                        let (mut plus, r_plus) = basis.row(link, e);
+                        let (minus, r_minus) = basis.row(link, o);
+                        let half = 0.5 * f32::from(e.side);
+                        for (a, b) in plus.iter_mut().zip(&minus) {
+                            *a = (*a - b) * half;
                         }
                         i += 2;
-                        0.5 * (r_plus - r_minus) * f32::from(e.side)
+                        (plus, (r_plus - r_minus) * half)
                     }
                     None => {
                         i += 1;
-                        edge_row(link, jac, e, &mut row)
+                        basis.row(link, e)
                     }
                 };
-                ne.add_row(&row, r, config.robust.weight(r), free);
+                block.add(&values, r, config.robust.weight(r));
                 added.edges += 1;
             }
         }
@@ -375,7 +533,7 @@ pub fn add_link_rows(
             if let Some(line) = fit_axis_line(link, features) {
                 for end in [0, 1] {
                     let r = line_row(link, jac, line, end, &mut row);
-                    ne.add_row(&row, r, 1.0, free);
+                    block.add_row(&row, r, 1.0);
                     added.edges += 1;
                 }
             }
@@ -383,9 +541,10 @@ pub fn add_link_rows(
     }
     if let Some(tip) = features.tip {
         let r = tip_row(link, jac, &tip, &mut row);
-        ne.add_row(&row, r, config.tip_weight * config.robust.weight(r), free);
+        block.add_row(&row, r, config.tip_weight * config.robust.weight(r));
         added.tips += 1;
     }
+    block.scatter(ne, &jac.states, free);
     added
 }
 

@@ -14,8 +14,9 @@ use nalgebra::Vector2;
 use crate::camera::Camera;
 use crate::config::{MAX_SLICES_PER_LINK, MAX_WINDOW};
 use crate::frame::FrameView;
+use crate::projection::Bounds;
 use crate::projection::ProjectedModel;
-use crate::visibility::{cover, Cover};
+use crate::visibility::{candidates, cover_among, Cover};
 
 /// Which sign of intensity change, going outward across an edge, counts as an edge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -228,42 +229,76 @@ pub fn find_link_features(
     let (dir, normal) = axis_frame(&link.a, &link.b);
     let slices = usize::from(config.slices_per_link).clamp(1, MAX_SLICES_PER_LINK);
     let mut profile = [0.0f32; MAX_WINDOW];
-    let mut search =
-        |centre: Vector2<f32>, outward: Vector2<f32>, depth: f32, out: &mut LinkFeatures| {
-            let mut over_hand = false;
-            if config.mask_occluded {
-                match cover(view, camera, index, &centre, depth) {
-                    Cover::Hidden => {
-                        out.masked += 1;
-                        return None;
-                    }
-                    Cover::Behind => over_hand = true,
-                    Cover::Clear => {
-                        over_hand = cover(view, camera, index, &(centre + outward * 2.0), depth)
-                            != Cover::Clear;
-                    }
-                }
-            }
-            let start = centre - outward * half;
-            if !frame.sample_segment(start, outward, &mut profile[..window]) {
-                out.off_frame += 1;
-                return None;
-            }
-            out.expected += 1;
-            let edge = if over_hand {
-                find_valley(&profile[..window], config.min_contrast)
-                    .or_else(|| find_edge(&profile[..window], Polarity::Any, config.min_contrast))?
-            } else {
-                find_edge(&profile[..window], config.polarity, config.min_contrast)?
-            };
-            Some((start + outward * edge.position, edge.strength))
-        };
-    for k in 0..slices {
-        let s = if slices == 1 {
+    // Every point `cover` is asked about (the predicted edges and tip, and 2 px beyond each),
+    // boxed, so only the links and palm whose bounds meet the box are tested.
+    let slice_s = |k: usize| {
+        if slices == 1 {
             0.5 * (config.span[0] + config.span[1])
         } else {
             config.span[0] + (config.span[1] - config.span[0]) * k as f32 / (slices - 1) as f32
+        }
+    };
+    let (among, palm) = if config.mask_occluded {
+        let mut region = Bounds {
+            min: Vector2::new(f32::INFINITY, f32::INFINITY),
+            max: Vector2::new(f32::NEG_INFINITY, f32::NEG_INFINITY),
         };
+        let mut grow = |p: Vector2<f32>, outward: Vector2<f32>| {
+            for q in [p, p + outward * 2.0] {
+                region.min = region.min.inf(&q);
+                region.max = region.max.sup(&q);
+            }
+        };
+        for k in 0..slices {
+            let s = slice_s(k);
+            let axis_point = link.a + (link.b - link.a) * s;
+            for side in [1i8, -1] {
+                let outward = normal * f32::from(side);
+                grow(axis_point + outward * link.side_radius_at(s, side), outward);
+            }
+        }
+        if config.tips && link.distal {
+            grow(link.b + dir * link.tip_offset, dir);
+        }
+        candidates(view, index, &region)
+    } else {
+        (heapless::Vec::new(), false)
+    };
+    let mut search = |centre: Vector2<f32>,
+                      outward: Vector2<f32>,
+                      depth: f32,
+                      out: &mut LinkFeatures| {
+        let mut over_hand = false;
+        if config.mask_occluded {
+            match cover_among(view, camera, &among, palm, &centre, depth) {
+                Cover::Hidden => {
+                    out.masked += 1;
+                    return None;
+                }
+                Cover::Behind => over_hand = true,
+                Cover::Clear => {
+                    over_hand =
+                        cover_among(view, camera, &among, palm, &(centre + outward * 2.0), depth)
+                            != Cover::Clear;
+                }
+            }
+        }
+        let start = centre - outward * half;
+        if !frame.sample_segment(start, outward, &mut profile[..window]) {
+            out.off_frame += 1;
+            return None;
+        }
+        out.expected += 1;
+        let edge = if over_hand {
+            find_valley(&profile[..window], config.min_contrast)
+                .or_else(|| find_edge(&profile[..window], Polarity::Any, config.min_contrast))?
+        } else {
+            find_edge(&profile[..window], config.polarity, config.min_contrast)?
+        };
+        Some((start + outward * edge.position, edge.strength))
+    };
+    for k in 0..slices {
+        let s = slice_s(k);
         let axis_point = link.a + (link.b - link.a) * s;
         let depth = link.depth_at(s);
         for side in [1i8, -1] {

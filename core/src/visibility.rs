@@ -52,3 +52,64 @@ pub fn cover(
     }
     result
 }
+
+/// The parts of the hand that can cover any point of the box `region` for link `link`: the
+/// other links (not sharing a joint with it) whose bounds meet the box, and whether the palm's
+/// do. [`cover_among`] over them answers as [`cover`] does for every point in the box.
+pub fn candidates(
+    view: &ProjectedModel,
+    link: usize,
+    region: &crate::projection::Bounds,
+) -> (heapless::Vec<u8, { crate::config::MAX_FRAMES }>, bool) {
+    let meets = |b: &crate::projection::Bounds| {
+        b.min.x <= region.max.x
+            && b.max.x >= region.min.x
+            && b.min.y <= region.max.y
+            && b.max.y >= region.min.y
+    };
+    let mut out = heapless::Vec::new();
+    for (j, other) in view.links.iter().enumerate() {
+        if j != link && meets(&other.bounds) && !view.adjacent(link, j) {
+            let _ = out.push(j as u8);
+        }
+    }
+    let palm = view.palm.as_ref().is_some_and(|p| meets(&p.bounds));
+    (out, palm)
+}
+
+/// [`cover`] restricted to the links `among` (indices into `view.links`) and, if `palm`, the
+/// palm: the same answer as `cover` when they are [`candidates`] for a box holding `p`.
+pub fn cover_among(
+    view: &ProjectedModel,
+    camera: &Camera,
+    among: &[u8],
+    palm: bool,
+    p: &Vector2<f32>,
+    depth: f32,
+) -> Cover {
+    let mut result = Cover::Clear;
+    for &j in among {
+        let Some(other) = view.links.get(usize::from(j)) else {
+            continue;
+        };
+        if !other.bounds.contains(p) {
+            continue;
+        }
+        let (s, dist) = other.closest(p);
+        if dist < other.radius_at(s) {
+            if other.depth_at(s) < depth {
+                return Cover::Hidden;
+            }
+            result = Cover::Behind;
+        }
+    }
+    if let (true, Some(palm)) = (palm, &view.palm) {
+        if let Some(z) = palm.depth_at(camera, p) {
+            if z < depth {
+                return Cover::Hidden;
+            }
+            result = Cover::Behind;
+        }
+    }
+    result
+}
