@@ -29,28 +29,9 @@ pub fn cover(
     p: &Vector2<f32>,
     depth: f32,
 ) -> Cover {
-    let mut result = Cover::Clear;
-    for (j, other) in view.links.iter().enumerate() {
-        if j == link || !other.bounds.contains(p) || view.adjacent(link, j) {
-            continue;
-        }
-        let (s, dist) = other.closest(p);
-        if dist < other.radius_at(s) {
-            if other.depth_at(s) < depth {
-                return Cover::Hidden;
-            }
-            result = Cover::Behind;
-        }
-    }
-    if let Some(palm) = &view.palm {
-        if let Some(z) = palm.depth_at(camera, p) {
-            if z < depth {
-                return Cover::Hidden;
-            }
-            result = Cover::Behind;
-        }
-    }
-    result
+    let point = crate::projection::Bounds { min: *p, max: *p };
+    let (among, palm) = candidates(view, link, &point);
+    cover_among(view, camera, &among, palm, p, depth)
 }
 
 /// The parts of the hand that can cover any point of the box `region` for link `link`: the
