@@ -16,6 +16,7 @@
 //! - [`features`]: the slice edge search of Sec. 4.3.1 with occlusion masking.
 //! - [`estimator`]: residuals, row-by-row normal equations, conditioned Gauss–Newton (Eq. 2.22).
 //! - [`tracker`]: the per-frame loop and its report.
+//! - [`protocol`]: the board link's messages and their framing (`docs/protocol.md`).
 //!
 //! Units everywhere: millimetres, radians, pixels (pixel (0, 0) is the centre of the top-left
 //! pixel). Numbers are `f32`. Every capacity is a named constant in [`config`]; exceeding one
@@ -33,6 +34,7 @@ pub mod kinematics;
 pub mod model;
 pub mod model_writer;
 pub mod projection;
+pub mod protocol;
 pub mod quaternion;
 pub mod tracker;
 pub mod visibility;

@@ -1,0 +1,291 @@
+//! The messages of the board link, in both directions.
+//!
+//! The wire form of every type here is postcard's (docs/protocol.md): enum variants are
+//! varint indices in declaration order, so **new variants and fields go at the end** and the
+//! [`PROTOCOL_VERSION`](super::PROTOCOL_VERSION) rises whenever a layout changes.
+
+use heapless::{String, Vec};
+use serde::{Deserialize, Serialize};
+
+use super::params::{CameraParams, TrackerParams};
+use crate::config::{MAX_FRAMES, MAX_STATES};
+
+/// Longest board name in [`Hello`] (bytes of UTF-8).
+pub const MAX_BOARD_NAME: usize = 24;
+
+/// Board → host.
+// `Features` is ~1.5 KB and the rest are small; without an allocator there is nothing to box
+// into, and a board holds one message at a time.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum BoardMessage {
+    /// Sent at boot and in answer to every [`HostMessage::Reset`]: who the board is.
+    Hello(Hello),
+    /// The estimated hand state for one tracked frame.
+    State(State),
+    /// The image features measured on one frame (what a stereo host fuses).
+    Features(Features),
+    /// Running counters; sent every `stats_every` frames and in answer to a `Ping`.
+    Stats(Stats),
+    /// A frame that will not be tracked, and why.
+    Dropped(Dropped),
+    /// A command was carried out.
+    Ack(Command),
+    /// A command was refused; the board's previous settings stay in force.
+    Nak(Command, Refusal),
+    /// The answer to [`HostMessage::Ping`], carrying its token.
+    Pong(u32),
+}
+
+/// Host → board.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum HostMessage<'a> {
+    /// Start tracking afresh from a state, estimating the `free` states.
+    Reset(Reset),
+    /// The camera and the tracker parameters. Needed once before frames are tracked.
+    Configure(Configure),
+    /// A piece of a frame uploaded over the link.
+    #[serde(borrow)]
+    FrameChunk(FrameChunk<'a>),
+    /// Asks for a [`BoardMessage::Stats`] and a [`BoardMessage::Pong`] with this token, sent
+    /// after everything the board received before the ping has been handled.
+    Ping(u32),
+}
+
+/// The host commands that are answered by [`BoardMessage::Ack`] or [`BoardMessage::Nak`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Command {
+    /// [`HostMessage::Reset`].
+    Reset,
+    /// [`HostMessage::Configure`].
+    Configure,
+}
+
+/// Why a command was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Refusal {
+    /// The camera is unusable (zero size, non-finite or non-positive focal length, …).
+    BadCamera,
+    /// A tracker parameter is out of range.
+    BadParameters,
+    /// The camera's frames do not fit the board's frame buffer.
+    FrameTooLarge,
+    /// The state has the wrong length for the model or is not finite.
+    BadState,
+    /// A `free` bit names no state of the model.
+    BadFreeMask,
+    /// `Reset` before `Configure`: the board has no camera yet.
+    NotConfigured,
+}
+
+/// Fixed capacities of the board, so a host can stay within them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Capacities {
+    /// States of the model (28 for the whole hand).
+    pub states: u8,
+    /// Most states a message can carry ([`MAX_STATES`]).
+    pub max_states: u8,
+    /// Most model frames ([`MAX_FRAMES`]).
+    pub max_frames: u8,
+    /// Largest frame the board's buffer holds (bytes = width × height).
+    pub max_frame_bytes: u32,
+    /// Largest `FrameChunk` payload (bytes).
+    pub max_chunk: u16,
+    /// Largest encoded message the board can receive (bytes, delimiters included).
+    pub max_message: u16,
+}
+
+/// Who the board is.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Hello {
+    /// The board's [`PROTOCOL_VERSION`](super::PROTOCOL_VERSION); a host refuses others.
+    pub version: u8,
+    /// e.g. `qemu-m7`, `linux`.
+    pub board: String<MAX_BOARD_NAME>,
+    /// [`model_digest`](super::model_digest) of the board's model.
+    pub model_digest: u32,
+    /// Ticks per second of the board clock used in [`State::timestamp`] and
+    /// [`State::track_ticks`].
+    pub clock_hz: u32,
+    /// The board's fixed capacities.
+    pub capacities: Capacities,
+}
+
+/// The estimated hand state for one frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct State {
+    /// The frame number given by the frame's source.
+    pub frame: u32,
+    /// Board clock (ticks of [`Hello::clock_hz`]) when the frame was complete.
+    pub timestamp: u64,
+    /// The state after tracking: every model state (quaternion, mm, rad).
+    pub q: Vec<f32, MAX_STATES>,
+    /// Residual RMS of the last iteration (px).
+    pub rms_px: f32,
+    /// The tracker does not trust this state.
+    pub lost: bool,
+    /// Features found in the last iteration.
+    pub features_found: u16,
+    /// Features expected in the last iteration.
+    pub features_expected: u16,
+    /// Gauss–Newton iterations run.
+    pub iterations: u8,
+    /// Board clock ticks spent tracking this frame.
+    pub track_ticks: u32,
+}
+
+/// A measured axis line in the image: a point on it and its unit direction (px).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AxisLine {
+    /// A point on the line (px).
+    pub point: [f32; 2],
+    /// Unit direction (from the link's base towards its tip).
+    pub direction: [f32; 2],
+}
+
+/// What was measured for one link.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LinkMeasurement {
+    /// Index of the model frame (link).
+    pub link: u8,
+    /// The link's measured axis, when enough edges were found.
+    pub axis: Option<AxisLine>,
+    /// The measured fingertip (px), for tip links.
+    pub tip: Option<[f32; 2]>,
+}
+
+/// The features of one frame of one camera.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Features {
+    /// The frame number.
+    pub frame: u32,
+    /// The camera (its index on the host; a board tracks one camera).
+    pub camera: u8,
+    /// One entry per link that was measured.
+    pub links: Vec<LinkMeasurement, MAX_FRAMES>,
+}
+
+/// Frames that were not tracked, by reason.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DropCounts {
+    /// A chunk went missing (a gap in the offsets): see [`DropReason::Incomplete`].
+    pub incomplete: u32,
+    /// Not the configured camera's size.
+    pub wrong_size: u32,
+    /// Larger than the board's frame buffer.
+    pub too_large: u32,
+    /// Arrived before `Configure` and `Reset`.
+    pub not_ready: u32,
+    /// A newer frame began before this one was complete.
+    pub superseded: u32,
+    /// The tracker refused the frame.
+    pub tracker_error: u32,
+}
+
+/// Link error counters of one receiver.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LinkCounters {
+    /// Messages decoded.
+    pub messages: u32,
+    /// Frames whose CRC-32 did not match.
+    pub crc_errors: u32,
+    /// Frames that were not valid COBS.
+    pub framing_errors: u32,
+    /// Frames with a good CRC that did not decode as a message (a newer protocol?).
+    pub decode_errors: u32,
+    /// Frames longer than the receive buffer.
+    pub overflows: u32,
+}
+
+/// The board's running counters since boot.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Stats {
+    /// Frames tracked.
+    pub frames: u32,
+    /// Gauss–Newton iterations run, in all.
+    pub iterations: u32,
+    /// Tracked frames reported `lost`.
+    pub lost: u32,
+    /// Frames not tracked, by reason.
+    pub dropped: DropCounts,
+    /// Frames rejected as malformed (wrong size, too large, chunk beyond the frame).
+    pub bad_frames: u32,
+    /// The board's receiver.
+    pub link: LinkCounters,
+    /// Capacity overflows: a message too large for the transmit buffer, features truncated.
+    pub capacity_overflows: u32,
+}
+
+/// Why a frame was not tracked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum DropReason {
+    /// A chunk went missing: the next chunk did not start where the last one ended.
+    Incomplete,
+    /// The frame is not the configured camera's size (its width and height).
+    WrongSize(u16, u16),
+    /// The frame is larger than the board's frame buffer, or a chunk runs past its end.
+    TooLarge,
+    /// The board had no camera (`Configure`) or no state (`Reset`) yet.
+    NotReady,
+    /// A chunk of a newer frame arrived before this one was complete.
+    Superseded,
+    /// The tracker refused the frame.
+    TrackerError,
+}
+
+/// A frame that will not be tracked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Dropped {
+    /// The frame number.
+    pub frame: u32,
+    /// Why.
+    pub reason: DropReason,
+}
+
+/// Start tracking afresh.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Reset {
+    /// Every model state (quaternion, mm, rad).
+    pub q: Vec<f32, MAX_STATES>,
+    /// Bit `i` set: state `i` is estimated; the others stay as given. Naming any quaternion
+    /// state frees all four.
+    pub free: u32,
+}
+
+/// The camera and how to track.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Configure {
+    /// The board's camera (frames must be its size).
+    pub camera: CameraParams,
+    /// Tracker parameters.
+    pub tracker: TrackerParams,
+    /// Send [`BoardMessage::Features`] every this many frames (0: never).
+    pub features_every: u16,
+    /// Send [`BoardMessage::Stats`] every this many frames (0: only when pinged).
+    pub stats_every: u16,
+}
+
+/// A piece of an 8-bit grey frame, rows top to bottom, packed (stride = width).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FrameChunk<'a> {
+    /// The frame number; all chunks of a frame carry the same one.
+    pub frame: u32,
+    /// Frame width (px).
+    pub width: u16,
+    /// Frame height (px).
+    pub height: u16,
+    /// Byte offset of `data` in the frame; chunks arrive in order, without gaps.
+    pub offset: u32,
+    /// The bytes (at most [`MAX_CHUNK`](super::MAX_CHUNK)).
+    pub data: &'a [u8],
+}

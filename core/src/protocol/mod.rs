@@ -1,0 +1,36 @@
+//! The board link: versioned messages between a board and its host.
+//!
+//! Every message is a postcard-encoded [`BoardMessage`] (board → host) or [`HostMessage`]
+//! (host → board), followed by its CRC-32 (little-endian), COBS-encoded and delimited by zero
+//! bytes on both sides:
+//!
+//! ```text
+//! 0x00 ‖ COBS( postcard(message) ‖ CRC-32/ISO-HDLC(postcard(message)) as u32 LE ) ‖ 0x00
+//! ```
+//!
+//! A receiver ([`Decoder`]) never panics: garbage, a corrupted byte, a frame longer than its
+//! buffer or an unknown message each cost one frame and one count in [`LinkCounters`], and
+//! the next frame decodes. The written spec is `docs/protocol.md`.
+
+mod digest;
+mod framing;
+mod messages;
+mod params;
+
+pub use digest::model_digest;
+pub use framing::{encode, max_encoded_len, Decoder, EncodeError, LinkError};
+pub use messages::*;
+pub use params::{BadParameter, CameraParams, TrackerParams, WireResidual, WireRobust};
+
+/// The protocol version in [`Hello`]; it rises whenever a message's layout changes.
+pub const PROTOCOL_VERSION: u8 = 1;
+
+/// Largest `FrameChunk` payload (bytes).
+pub const MAX_CHUNK: usize = 1024;
+
+/// Largest encoded message either side sends (bytes, delimiters included): a full
+/// `FrameChunk` with its header, CRC and COBS overhead fits, with room to spare.
+pub const MAX_MESSAGE: usize = 1152;
+
+/// The CRC of every frame: CRC-32/ISO-HDLC (the zlib/Ethernet CRC-32).
+pub(crate) static CRC: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);

@@ -1,0 +1,338 @@
+//! The board link: every message round-trips, the largest fit the buffers, the digest tells
+//! models apart, parameters are range-checked, and the decoder counts and survives garbage.
+
+use digiteyes_core::model::{Limit, Model};
+use digiteyes_core::protocol::*;
+use digiteyes_core::tracker::TrackerConfig;
+use heapless::{String, Vec};
+
+type Rx = Decoder<MAX_MESSAGE>;
+
+fn full_q(n: usize) -> Vec<f32, 32> {
+    (0..n).map(|i| i as f32 * 0.125 - 1.0).collect()
+}
+
+fn camera() -> CameraParams {
+    CameraParams {
+        width: 640,
+        height: 480,
+        intrinsics: [600.0, 600.0, 319.5, 239.5],
+        r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+        t: [0.0, 0.0, 500.0],
+    }
+}
+
+fn board_messages() -> std::vec::Vec<BoardMessage> {
+    let mut links = Vec::new();
+    for link in 0..48u8 {
+        let axis = (link % 3 != 0).then_some(AxisLine {
+            point: [f32::from(link), 2.5],
+            direction: [0.6, -0.8],
+        });
+        let tip = (link % 4 == 0).then_some([1.0, f32::from(link)]);
+        links.push(LinkMeasurement { link, axis, tip }).unwrap();
+    }
+    vec![
+        BoardMessage::Hello(Hello {
+            version: PROTOCOL_VERSION,
+            board: String::try_from("a-board-name-of-24-bytes").unwrap(),
+            model_digest: 0xdead_beef,
+            clock_hz: 25_000_000,
+            capacities: Capacities {
+                states: 28,
+                max_states: 32,
+                max_frames: 48,
+                max_frame_bytes: 640 * 480,
+                max_chunk: MAX_CHUNK as u16,
+                max_message: MAX_MESSAGE as u16,
+            },
+        }),
+        BoardMessage::State(State {
+            frame: u32::MAX,
+            timestamp: u64::MAX,
+            q: full_q(32),
+            rms_px: f32::NAN,
+            lost: true,
+            features_found: u16::MAX,
+            features_expected: u16::MAX,
+            iterations: u8::MAX,
+            track_ticks: u32::MAX,
+        }),
+        BoardMessage::Features(Features {
+            frame: 7,
+            camera: 1,
+            links,
+        }),
+        BoardMessage::Stats(Stats {
+            frames: u32::MAX,
+            iterations: u32::MAX,
+            lost: u32::MAX,
+            dropped: DropCounts {
+                incomplete: u32::MAX,
+                wrong_size: u32::MAX,
+                too_large: u32::MAX,
+                not_ready: u32::MAX,
+                superseded: u32::MAX,
+                tracker_error: u32::MAX,
+            },
+            bad_frames: u32::MAX,
+            link: LinkCounters {
+                messages: u32::MAX,
+                crc_errors: u32::MAX,
+                framing_errors: u32::MAX,
+                decode_errors: u32::MAX,
+                overflows: u32::MAX,
+            },
+            capacity_overflows: u32::MAX,
+        }),
+        BoardMessage::Dropped(Dropped {
+            frame: 3,
+            reason: DropReason::WrongSize(320, 240),
+        }),
+        BoardMessage::Dropped(Dropped {
+            frame: 4,
+            reason: DropReason::Incomplete,
+        }),
+        BoardMessage::Ack(Command::Configure),
+        BoardMessage::Nak(Command::Reset, Refusal::BadFreeMask),
+        BoardMessage::Pong(0x0102_0304),
+    ]
+}
+
+fn host_messages(data: &[u8]) -> std::vec::Vec<HostMessage<'_>> {
+    vec![
+        HostMessage::Reset(Reset {
+            q: full_q(32),
+            free: u32::MAX,
+        }),
+        HostMessage::Configure(Configure {
+            camera: camera(),
+            tracker: TrackerParams::default(),
+            features_every: u16::MAX,
+            stats_every: u16::MAX,
+        }),
+        HostMessage::FrameChunk(FrameChunk {
+            frame: u32::MAX,
+            width: u16::MAX,
+            height: u16::MAX,
+            offset: u32::MAX,
+            data,
+        }),
+        HostMessage::Ping(u32::MAX),
+    ]
+}
+
+/// Feeds a whole stream; collects what each frame decoded to.
+fn decode_all<T, F>(rx: &mut Rx, mut stream: &[u8], mut each: F)
+where
+    F: FnMut(Result<T, LinkError>),
+    T: for<'d> serde::Deserialize<'d>,
+{
+    while !stream.is_empty() {
+        let (used, out) = rx.feed::<T>(stream);
+        if let Some(out) = out {
+            each(out);
+        }
+        stream = &stream[used..];
+    }
+}
+
+fn same(a: &BoardMessage, b: &BoardMessage) -> bool {
+    // NaN != NaN: compare the encodings instead.
+    let (mut x, mut y) = ([0u8; MAX_MESSAGE], [0u8; MAX_MESSAGE]);
+    encode(a, &mut x).unwrap() == encode(b, &mut y).unwrap()
+}
+
+#[test]
+fn every_board_message_round_trips_and_fits() {
+    for message in board_messages() {
+        let mut buf = [0u8; MAX_MESSAGE];
+        let frame = encode(&message, &mut buf).unwrap();
+        assert!(frame.len() <= MAX_MESSAGE);
+        assert!(frame.len() <= max_encoded_len(&message).unwrap());
+        assert_eq!((frame[0], frame[frame.len() - 1]), (0, 0));
+        assert!(
+            !frame[1..frame.len() - 1].contains(&0),
+            "COBS leaves no zero inside"
+        );
+        let mut rx = Rx::new();
+        let (used, out) = rx.feed::<BoardMessage>(frame);
+        assert_eq!(used, frame.len());
+        assert!(same(&out.unwrap().unwrap(), &message), "{message:?}");
+    }
+}
+
+#[test]
+fn every_host_message_round_trips_and_the_largest_chunk_fits() {
+    let data: std::vec::Vec<u8> = (0..MAX_CHUNK).map(|i| (i % 251) as u8).collect();
+    for message in host_messages(&data) {
+        let mut buf = [0u8; MAX_MESSAGE];
+        let frame = encode(&message, &mut buf).unwrap().to_vec();
+        assert!(frame.len() <= MAX_MESSAGE, "{} bytes", frame.len());
+        let mut rx = Rx::new();
+        let (_, out) = rx.feed::<HostMessage>(&frame);
+        assert_eq!(out.unwrap().unwrap(), message);
+    }
+}
+
+#[test]
+fn encoding_into_a_small_buffer_is_an_error_not_a_panic() {
+    let message = BoardMessage::Pong(5);
+    let mut buf = [0u8; 64];
+    let full = encode(&message, &mut buf).unwrap().len();
+    for size in 0..full {
+        let mut small = vec![0u8; size];
+        assert_eq!(encode(&message, &mut small), Err(EncodeError::BufferFull));
+    }
+}
+
+#[test]
+fn a_stream_cut_anywhere_decodes_the_same() {
+    let mut stream = std::vec::Vec::new();
+    let messages = board_messages();
+    for m in &messages {
+        let mut buf = [0u8; MAX_MESSAGE];
+        stream.extend_from_slice(encode(m, &mut buf).unwrap());
+    }
+    for piece in [1, 2, 3, 7, 64, 1000] {
+        let mut rx = Rx::new();
+        let mut got = std::vec::Vec::new();
+        for chunk in stream.chunks(piece) {
+            decode_all::<BoardMessage, _>(&mut rx, chunk, |m| got.push(m.unwrap()));
+        }
+        assert_eq!(got.len(), messages.len());
+        assert!(got.iter().zip(&messages).all(|(a, b)| same(a, b)));
+        assert_eq!(rx.counters().messages as usize, messages.len());
+    }
+}
+
+#[test]
+fn garbage_before_a_message_costs_only_the_garbage() {
+    let mut buf = [0u8; MAX_MESSAGE];
+    let frame = encode(&BoardMessage::Pong(9), &mut buf).unwrap();
+    let mut stream = b"\x13\x37 line noise without a delimiter".to_vec();
+    stream.extend_from_slice(frame);
+    let mut rx = Rx::new();
+    let mut got = std::vec::Vec::new();
+    decode_all::<BoardMessage, _>(&mut rx, &stream, |m| got.push(m));
+    assert_eq!(got.len(), 2);
+    assert!(got[0].is_err());
+    assert_eq!(got[1], Ok(BoardMessage::Pong(9)));
+}
+
+#[test]
+fn each_kind_of_error_is_told_apart_and_counted() {
+    let mut rx = Rx::new();
+    let mut buf = [0u8; MAX_MESSAGE];
+    let good = encode(&BoardMessage::Pong(1), &mut buf).unwrap().to_vec();
+
+    // One flipped bit inside the payload: the CRC catches it.
+    let mut flipped = good.clone();
+    flipped[3] ^= 0x10;
+    let mut errors = std::vec::Vec::new();
+    decode_all::<BoardMessage, _>(&mut rx, &flipped, |m| errors.push(m.unwrap_err()));
+    assert_eq!(errors, [LinkError::Crc]);
+
+    // A COBS code byte pointing past the frame's end.
+    decode_all::<BoardMessage, _>(&mut rx, &[0, 0x40, 1, 2, 0], |m| {
+        assert_eq!(m.unwrap_err(), LinkError::Framing)
+    });
+
+    // A good CRC over bytes that are no message (variant 200).
+    let mut raw = [200u8, 1, 0, 0, 0, 0, 0, 0, 0];
+    let crc = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC).checksum(&raw[..1]);
+    raw[1..5].copy_from_slice(&crc.to_le_bytes());
+    let mut cobs_buf = [0u8; 16];
+    let n = cobs::encode(&raw[..5], &mut cobs_buf);
+    let mut frame = vec![0];
+    frame.extend_from_slice(&cobs_buf[..n]);
+    frame.push(0);
+    decode_all::<BoardMessage, _>(&mut rx, &frame, |m| {
+        assert_eq!(m.unwrap_err(), LinkError::Decode)
+    });
+
+    // Longer than the receive buffer.
+    let long = vec![0x55u8; MAX_MESSAGE + 10];
+    decode_all::<BoardMessage, _>(&mut rx, &long, |_| panic!("no delimiter yet"));
+    decode_all::<BoardMessage, _>(&mut rx, &[0], |m| {
+        assert_eq!(m.unwrap_err(), LinkError::Overflow)
+    });
+
+    // And the next good frame still decodes.
+    decode_all::<BoardMessage, _>(&mut rx, &good, |m| {
+        assert_eq!(m.unwrap(), BoardMessage::Pong(1))
+    });
+    let c = rx.counters();
+    assert_eq!(
+        (
+            c.crc_errors,
+            c.framing_errors,
+            c.decode_errors,
+            c.overflows,
+            c.messages
+        ),
+        (1, 1, 1, 1, 1)
+    );
+}
+
+#[test]
+fn a_message_for_the_other_direction_is_a_decode_error() {
+    let mut buf = [0u8; MAX_MESSAGE];
+    let frame = encode(&HostMessage::Ping(3), &mut buf).unwrap();
+    let mut rx = Rx::new();
+    let (_, out) = rx.feed::<BoardMessage>(frame);
+    // Ping (variant 3) reads as a Stats whose fields run out: never mistaken for a message.
+    assert_eq!(out, Some(Err(LinkError::Decode)));
+}
+
+#[test]
+fn model_digest_tells_models_apart() {
+    let hand = Model::hand().unwrap();
+    let reparsed = Model::parse(digiteyes_core::model::HAND_DH).unwrap();
+    assert_eq!(model_digest(&hand), model_digest(&reparsed));
+    let mut changed = hand.clone();
+    changed.set_limit(7, Some(Limit { lo: -0.5, hi: 0.25 }));
+    assert_ne!(model_digest(&hand), model_digest(&changed));
+}
+
+#[test]
+fn tracker_parameters_round_trip_and_are_range_checked() {
+    let config = TrackerConfig::default();
+    let params = TrackerParams::from_config(&config);
+    assert_eq!(params.to_config().unwrap(), config);
+
+    type Spoil = fn(&mut TrackerParams);
+    let bad: [(&str, Spoil); 9] = [
+        ("iterations", |p| p.iterations = 0),
+        ("slices_per_link", |p| p.slices_per_link = 200),
+        ("window_px", |p| p.window_px = 2),
+        ("min_contrast", |p| p.min_contrast = f32::NAN),
+        ("conditioning", |p| p.conditioning[2] = -1.0),
+        ("lost_min_found", |p| p.lost_min_found = 1.5),
+        ("lost_rms_px", |p| p.lost_rms_px = f32::INFINITY),
+        ("robust", |p| p.robust = WireRobust::Huber(0.0)),
+        ("robust", |p| p.robust = WireRobust::Tukey(f32::NAN)),
+    ];
+    for (name, spoil) in bad {
+        let mut p = params;
+        spoil(&mut p);
+        assert_eq!(p.to_config(), Err(BadParameter(name)));
+    }
+}
+
+#[test]
+fn camera_parameters_round_trip_and_bad_cameras_are_refused() {
+    let wire = camera();
+    let cam = wire.to_camera().unwrap();
+    assert_eq!(CameraParams::from_camera(&cam), Some(wire));
+    assert_eq!(wire.frame_bytes(), 640 * 480);
+    let mut bad = wire;
+    bad.intrinsics[0] = 0.0;
+    assert!(bad.to_camera().is_err());
+    let mut bad = wire;
+    bad.r[0] = 2.0;
+    assert!(bad.to_camera().is_err());
+    let mut bad = wire;
+    bad.width = 0;
+    assert!(bad.to_camera().is_err());
+}
