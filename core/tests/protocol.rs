@@ -25,13 +25,15 @@ fn camera() -> CameraParams {
 fn board_messages() -> std::vec::Vec<BoardMessage> {
     let mut links = Vec::new();
     for link in 0..48u8 {
-        let axis = (link % 3 != 0).then_some(AxisLine {
+        // Every link with both an axis and a tip: the largest Features there can be.
+        let axis = Some(AxisLine {
             point: [f32::from(link), 2.5],
             direction: [0.6, -0.8],
         });
-        let tip = (link % 4 == 0).then_some([1.0, f32::from(link)]);
+        let tip = Some([1.0, f32::from(link)]);
         links.push(LinkMeasurement { link, axis, tip }).unwrap();
     }
+    let frame = u32::MAX;
     vec![
         BoardMessage::Hello(Hello {
             version: PROTOCOL_VERSION,
@@ -59,8 +61,8 @@ fn board_messages() -> std::vec::Vec<BoardMessage> {
             track_ticks: u32::MAX,
         }),
         BoardMessage::Features(Features {
-            frame: 7,
-            camera: 1,
+            frame,
+            camera: u8::MAX,
             links,
         }),
         BoardMessage::Stats(Stats {
@@ -335,4 +337,18 @@ fn camera_parameters_round_trip_and_bad_cameras_are_refused() {
     let mut bad = wire;
     bad.width = 0;
     assert!(bad.to_camera().is_err());
+}
+
+#[test]
+fn the_largest_messages_nearly_fill_max_message() {
+    // MAX_MESSAGE is sized by the largest message, not guessed: within 10 % of it.
+    let largest = board_messages()
+        .iter()
+        .map(|m| {
+            let mut buf = [0u8; MAX_MESSAGE];
+            encode(m, &mut buf).unwrap().len()
+        })
+        .max()
+        .unwrap();
+    assert!(largest * 10 >= MAX_MESSAGE * 9, "{largest} of {MAX_MESSAGE}");
 }

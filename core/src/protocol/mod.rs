@@ -28,9 +28,11 @@ pub const PROTOCOL_VERSION: u8 = 1;
 /// Largest `FrameChunk` payload (bytes).
 pub const MAX_CHUNK: usize = 1024;
 
-/// Largest encoded message either side sends (bytes, delimiters included): a full
-/// `FrameChunk` with its header, CRC and COBS overhead fits, with room to spare.
-pub const MAX_MESSAGE: usize = 1152;
+/// Largest encoded message either side sends (bytes, delimiters included), so the size of
+/// every receive and transmit buffer: the largest are a `Features` naming all
+/// [`MAX_FRAMES`](crate::config::MAX_FRAMES) links (1,315 bytes) and a full `FrameChunk`
+/// (about 1,050 bytes); `tests/protocol.rs` checks both fit.
+pub const MAX_MESSAGE: usize = 1408;
 
 /// The CRC of every frame: CRC-32/ISO-HDLC (the zlib/Ethernet CRC-32).
 pub(crate) static CRC: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
