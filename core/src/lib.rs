@@ -16,6 +16,7 @@
 //! - [`features`]: the slice edge search of Sec. 4.3.1 with occlusion masking.
 //! - [`estimator`]: residuals, row-by-row normal equations, conditioned Gauss–Newton (Eq. 2.22).
 //! - [`tracker`]: the per-frame loop and its report.
+//! - [`measurement`]: measured axis lines and fingertips at a state, for a stereo host.
 //! - [`protocol`]: the board link's messages and their framing (`docs/protocol.md`).
 //!
 //! Units everywhere: millimetres, radians, pixels (pixel (0, 0) is the centre of the top-left
@@ -31,6 +32,7 @@ pub mod estimator;
 pub mod features;
 pub mod frame;
 pub mod kinematics;
+pub mod measurement;
 pub mod model;
 pub mod model_writer;
 pub mod projection;

@@ -1,0 +1,453 @@
+//! The board loop: host commands in, frames tracked, states out.
+
+use core::convert::Infallible;
+
+use digiteyes_core::camera::Camera;
+use digiteyes_core::frame::FrameView;
+use digiteyes_core::measurement::measure_links;
+use digiteyes_core::model::Model;
+use digiteyes_core::protocol::{
+    encode, model_digest, BoardMessage, Capacities, Command, Configure, Decoder, DropReason,
+    Dropped, Features, FrameChunk, Hello, HostMessage, Refusal, Reset, State, Stats, MAX_CHUNK,
+    MAX_MESSAGE, PROTOCOL_VERSION,
+};
+use digiteyes_core::tracker::{Tracker, TrackerConfig, TrackerError};
+use embedded_hal::delay::DelayNs;
+use embedded_hal::digital::OutputPin;
+use embedded_io::{Read, ReadReady, Write};
+use heapless::{String, Vec};
+
+use crate::clock::Clock;
+use crate::log::{info, log_warn};
+use crate::overlay;
+use crate::source::FrameSource;
+use crate::upload::{ChunkOutcome, Upload};
+
+/// Bytes read from the serial port per `read` call.
+const READ_BLOCK: usize = 64;
+
+/// The camera and parameters of the last accepted `Configure`.
+#[derive(Debug, Clone, Copy)]
+struct Setup {
+    camera: Camera,
+    config: TrackerConfig,
+    features_every: u16,
+    stats_every: u16,
+}
+
+/// Everything but the receiver, so a received message (which borrows the receiver's buffer)
+/// can be handled while the rest of the board changes.
+struct Node<'m, S, F, L, C> {
+    name: &'static str,
+    model: Option<Model>,
+    frame: &'m mut [u8],
+    overlay: Option<&'m mut [u8]>,
+    overlay_ready: bool,
+    serial: S,
+    source: F,
+    led: L,
+    clock: C,
+    tx: [u8; MAX_MESSAGE],
+    setup: Option<Setup>,
+    tracker: Option<Tracker>,
+    upload: Upload,
+    stats: Stats,
+}
+
+/// One board: a tracker, its frame buffer and its serial link.
+pub struct Board<'m, S, F, L, C> {
+    rx: Decoder<MAX_MESSAGE>,
+    node: Node<'m, S, F, L, C>,
+}
+
+impl<'m, S, F, L, C> Board<'m, S, F, L, C>
+where
+    S: Read + Write + ReadReady,
+    F: FrameSource,
+    L: OutputPin,
+    C: Clock,
+{
+    /// A board named `name` (in `Hello`) tracking the built-in hand model. `frame_buffer`
+    /// holds one frame: its length is the largest frame accepted. `overlay`, when given,
+    /// receives each tracked frame with the model drawn in (it must be as long).
+    pub fn new(
+        name: &'static str,
+        frame_buffer: &'m mut [u8],
+        overlay: Option<&'m mut [u8]>,
+        serial: S,
+        source: F,
+        led: L,
+        clock: C,
+    ) -> Self {
+        Board {
+            rx: Decoder::new(),
+            node: Node {
+                name,
+                model: Model::hand().ok(),
+                frame: frame_buffer,
+                overlay,
+                overlay_ready: false,
+                serial,
+                source,
+                led,
+                clock,
+                tx: [0; MAX_MESSAGE],
+                setup: None,
+                tracker: None,
+                upload: Upload::new(),
+                stats: Stats::default(),
+            },
+        }
+    }
+
+    /// Announces the board with `Hello`; call once at boot.
+    pub fn start(&mut self) -> Result<(), S::Error> {
+        info!("digiteyes board up");
+        self.node.set_led(false);
+        self.node.hello()
+    }
+
+    /// One pass of the loop: drains the serial bytes that are ready (never waits for more),
+    /// handles each message, and tracks a camera frame if one is ready. Returns whether it did
+    /// anything.
+    pub fn poll(&mut self) -> Result<bool, S::Error> {
+        let mut busy = false;
+        let mut block = [0u8; READ_BLOCK];
+        while self.node.serial.read_ready()? {
+            let n = self.node.serial.read(&mut block)?;
+            if n == 0 {
+                break;
+            }
+            busy = true;
+            let mut rest = block.get(..n).unwrap_or_default();
+            while !rest.is_empty() {
+                let (used, out) = self.rx.feed::<HostMessage>(rest);
+                rest = rest.get(used..).unwrap_or_default();
+                match out {
+                    Some(Ok(message)) => self.node.handle(message)?,
+                    Some(Err(_e)) => log_warn!("link: {}", _e),
+                    None => {}
+                }
+            }
+            self.node.stats.link = self.rx.counters();
+        }
+        busy |= self.node.poll_camera()?;
+        self.node.stats.link = self.rx.counters();
+        Ok(busy)
+    }
+
+    /// [`start`](Self::start), then [`poll`](Self::poll) forever, sleeping `idle_us` whenever
+    /// a pass found nothing to do. Returns only on a serial error.
+    pub fn run<D: DelayNs>(&mut self, delay: &mut D, idle_us: u32) -> Result<Infallible, S::Error> {
+        self.start()?;
+        loop {
+            if !self.poll()? {
+                delay.delay_us(idle_us);
+            }
+        }
+    }
+
+    /// The counters since boot.
+    pub fn stats(&self) -> Stats {
+        let mut stats = self.node.stats;
+        stats.link = self.rx.counters();
+        stats
+    }
+
+    /// The last tracked frame with the model drawn in, when an overlay buffer was given.
+    pub fn overlay(&self) -> Option<&[u8]> {
+        let setup = self.node.setup.as_ref()?;
+        let n = setup.camera.width as usize * setup.camera.height as usize;
+        self.node
+            .overlay
+            .as_deref()
+            .filter(|_| self.node.overlay_ready)?
+            .get(..n)
+    }
+
+    /// The serial port (e.g. to inject bytes in a test).
+    pub fn serial_mut(&mut self) -> &mut S {
+        &mut self.node.serial
+    }
+}
+
+impl<S, F, L, C> Node<'_, S, F, L, C>
+where
+    S: Read + Write + ReadReady,
+    F: FrameSource,
+    L: OutputPin,
+    C: Clock,
+{
+    fn handle(&mut self, message: HostMessage<'_>) -> Result<(), S::Error> {
+        match message {
+            HostMessage::Configure(configure) => self.configure(&configure),
+            HostMessage::Reset(reset) => self.reset(&reset),
+            HostMessage::FrameChunk(chunk) => self.chunk(&chunk),
+            HostMessage::Ping(token) => {
+                let stats = self.stats;
+                self.send(&BoardMessage::Stats(stats))?;
+                self.send(&BoardMessage::Pong(token))
+            }
+        }
+    }
+
+    fn configure(&mut self, configure: &Configure) -> Result<(), S::Error> {
+        match self.apply_configure(configure) {
+            Ok(()) => {
+                self.abandon_upload()?;
+                self.send(&BoardMessage::Ack(Command::Configure))
+            }
+            Err(refusal) => self.send(&BoardMessage::Nak(Command::Configure, refusal)),
+        }
+    }
+
+    fn apply_configure(&mut self, configure: &Configure) -> Result<(), Refusal> {
+        let camera = configure
+            .camera
+            .to_camera()
+            .map_err(|_| Refusal::BadCamera)?;
+        let config = configure
+            .tracker
+            .to_config()
+            .map_err(|_| Refusal::BadParameters)?;
+        if configure.camera.frame_bytes() > self.frame.len() {
+            return Err(Refusal::FrameTooLarge);
+        }
+        if let Some(tracker) = &self.tracker {
+            // Keep estimating from where the board is, with the new camera and parameters.
+            let state: Vec<f32, 32> = Vec::from_slice(tracker.state()).unwrap_or_default();
+            let free = tracker.free().0;
+            self.tracker = Some(self.build_tracker(&camera, config, &state, free)?);
+        }
+        self.setup = Some(Setup {
+            camera,
+            config,
+            features_every: configure.features_every,
+            stats_every: configure.stats_every,
+        });
+        Ok(())
+    }
+
+    fn reset(&mut self, reset: &Reset) -> Result<(), S::Error> {
+        let built = match &self.setup {
+            None => Err(Refusal::NotConfigured),
+            Some(setup) => {
+                let (camera, config) = (setup.camera, setup.config);
+                self.build_tracker(&camera, config, &reset.q, reset.free)
+            }
+        };
+        match built {
+            Ok(tracker) => {
+                self.tracker = Some(tracker);
+                self.abandon_upload()?;
+                self.hello()?;
+                self.send(&BoardMessage::Ack(Command::Reset))
+            }
+            Err(refusal) => self.send(&BoardMessage::Nak(Command::Reset, refusal)),
+        }
+    }
+
+    fn build_tracker(
+        &self,
+        camera: &Camera,
+        config: TrackerConfig,
+        q: &[f32],
+        free: u32,
+    ) -> Result<Tracker, Refusal> {
+        let model = self.model.clone().ok_or(Refusal::BadState)?;
+        if q.len() != model.n_states() || q.iter().any(|v| !v.is_finite()) {
+            return Err(Refusal::BadState);
+        }
+        if model.n_states() < 32 && free >> model.n_states() != 0 {
+            return Err(Refusal::BadFreeMask);
+        }
+        let list: Vec<u8, 32> = (0..32u8).filter(|&i| free & (1 << i) != 0).collect();
+        Tracker::new(model, &[*camera], q, Some(&list), config).map_err(|e| match e {
+            TrackerError::BadFreeState(_) => Refusal::BadFreeMask,
+            TrackerError::Camera(_) | TrackerError::CameraCount => Refusal::BadCamera,
+            _ => Refusal::BadState,
+        })
+    }
+
+    /// Drops and reports a partly uploaded frame: after a new setup its chunks no longer fit.
+    fn abandon_upload(&mut self) -> Result<(), S::Error> {
+        match self.upload.abandon() {
+            Some(frame) => self.report_drop(Dropped {
+                frame,
+                reason: DropReason::Superseded,
+            }),
+            None => Ok(()),
+        }
+    }
+
+    fn chunk(&mut self, chunk: &FrameChunk<'_>) -> Result<(), S::Error> {
+        let expected = match (&self.setup, &self.tracker) {
+            (Some(setup), Some(_)) => {
+                let (w, h) = (setup.camera.width, setup.camera.height);
+                Some((w as u16, h as u16))
+            }
+            _ => None,
+        };
+        let (superseded, outcome) = self.upload.accept(chunk, expected, self.frame);
+        if let Some(dropped) = superseded {
+            self.report_drop(dropped)?;
+        }
+        match outcome {
+            ChunkOutcome::Partial | ChunkOutcome::Ignored => Ok(()),
+            ChunkOutcome::Dropped(dropped) => self.report_drop(dropped),
+            ChunkOutcome::Complete { frame, .. } => self.track(frame),
+        }
+    }
+
+    fn poll_camera(&mut self) -> Result<bool, S::Error> {
+        let (Some(setup), Some(_)) = (&self.setup, &self.tracker) else {
+            return Ok(false);
+        };
+        if self.upload.in_progress() {
+            return Ok(false);
+        }
+        let (w, h) = (setup.camera.width as u16, setup.camera.height as u16);
+        let n = usize::from(w) * usize::from(h);
+        let Some(buffer) = self.frame.get_mut(..n) else {
+            return Ok(false);
+        };
+        match self.source.poll_frame(buffer, w, h) {
+            Ok(Some(frame)) => self.track(frame).map(|()| true),
+            Ok(None) => Ok(false),
+            Err(_) => {
+                self.stats.bad_frames += 1;
+                Ok(false)
+            }
+        }
+    }
+
+    fn track(&mut self, frame: u32) -> Result<(), S::Error> {
+        let (Some(setup), Some(tracker)) = (self.setup, self.tracker.as_mut()) else {
+            return self.report_drop(Dropped {
+                frame,
+                reason: DropReason::NotReady,
+            });
+        };
+        let (w, h) = (setup.camera.width as usize, setup.camera.height as usize);
+        let timestamp = self.clock.ticks();
+        let pixels = self.frame.get(..w * h).unwrap_or_default();
+        let report = match FrameView::packed(pixels, w, h) {
+            Ok(view) => tracker.track(&[view]),
+            Err(e) => Err(TrackerError::Frame(e)),
+        };
+        let track_ticks = self.clock.ticks().saturating_sub(timestamp);
+        let report = match report {
+            Ok(report) => report,
+            Err(_) => {
+                return self.report_drop(Dropped {
+                    frame,
+                    reason: DropReason::TrackerError,
+                })
+            }
+        };
+        self.stats.frames += 1;
+        self.stats.iterations += u32::from(report.iterations);
+        self.stats.lost += u32::from(report.lost);
+        let q = Vec::from_slice(tracker.state()).unwrap_or_default();
+        if let Some(out) = self.overlay.as_deref_mut() {
+            overlay::draw(tracker.model(), &setup.camera, tracker.state(), pixels, out);
+            self.overlay_ready = true;
+        }
+        let measurements = (setup.features_every != 0
+            && self.stats.frames % u32::from(setup.features_every) == 0)
+            .then(|| match FrameView::packed(pixels, w, h) {
+                Ok(view) => measure_links(
+                    tracker.model(),
+                    &setup.camera,
+                    tracker.state(),
+                    &view,
+                    &setup.config.features,
+                ),
+                Err(_) => Vec::new(),
+            });
+        self.set_led(!report.lost);
+        self.send(&BoardMessage::State(State {
+            frame,
+            timestamp,
+            q,
+            rms_px: report.rms_px,
+            lost: report.lost,
+            features_found: report.features_found,
+            features_expected: report.features_expected,
+            iterations: report.iterations,
+            track_ticks: u32::try_from(track_ticks).unwrap_or(u32::MAX),
+        }))?;
+        if let Some(links) = measurements {
+            self.send(&BoardMessage::Features(Features {
+                frame,
+                camera: 0,
+                links,
+            }))?;
+        }
+        if setup.stats_every != 0 && self.stats.frames % u32::from(setup.stats_every) == 0 {
+            let stats = self.stats;
+            self.send(&BoardMessage::Stats(stats))?;
+        }
+        Ok(())
+    }
+
+    fn report_drop(&mut self, dropped: Dropped) -> Result<(), S::Error> {
+        let counts = &mut self.stats.dropped;
+        match dropped.reason {
+            DropReason::Incomplete => counts.incomplete += 1,
+            DropReason::WrongSize(..) => counts.wrong_size += 1,
+            DropReason::TooLarge => counts.too_large += 1,
+            DropReason::NotReady => counts.not_ready += 1,
+            DropReason::Superseded => counts.superseded += 1,
+            DropReason::TrackerError => counts.tracker_error += 1,
+        }
+        if matches!(
+            dropped.reason,
+            DropReason::WrongSize(..) | DropReason::TooLarge
+        ) {
+            self.stats.bad_frames += 1;
+        }
+        self.send(&BoardMessage::Dropped(dropped))
+    }
+
+    fn hello(&mut self) -> Result<(), S::Error> {
+        let model = self.model.as_ref();
+        let hello = Hello {
+            version: PROTOCOL_VERSION,
+            board: String::try_from(self.name).unwrap_or_default(),
+            model_digest: model.map_or(0, model_digest),
+            clock_hz: self.clock.hz(),
+            capacities: Capacities {
+                states: model.map_or(0, |m| m.n_states() as u8),
+                max_states: digiteyes_core::config::MAX_STATES as u8,
+                max_frames: digiteyes_core::config::MAX_FRAMES as u8,
+                max_frame_bytes: u32::try_from(self.frame.len()).unwrap_or(u32::MAX),
+                max_chunk: MAX_CHUNK as u16,
+                max_message: MAX_MESSAGE as u16,
+            },
+        };
+        self.send(&BoardMessage::Hello(hello))
+    }
+
+    fn send(&mut self, message: &BoardMessage) -> Result<(), S::Error> {
+        match encode(message, &mut self.tx) {
+            Ok(bytes) => {
+                self.serial.write_all(bytes)?;
+                self.serial.flush()
+            }
+            Err(_) => {
+                self.stats.capacity_overflows += 1;
+                Ok(())
+            }
+        }
+    }
+
+    fn set_led(&mut self, on: bool) {
+        // A status LED that fails to switch is not worth stopping the tracker for.
+        let _ = if on {
+            self.led.set_high()
+        } else {
+            self.led.set_low()
+        };
+    }
+}

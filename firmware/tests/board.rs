@@ -1,0 +1,575 @@
+//! The board loop against an in-memory serial port: the session of docs/protocol.md, states
+//! equal to an in-process tracker's, every drop reported once with its reason, refusals,
+//! corruption counted and survived, the camera source, features and the overlay.
+
+mod common;
+
+use common::*;
+use digiteyes_core::frame::FrameView;
+use digiteyes_core::model::Model;
+use digiteyes_core::protocol::*;
+use digiteyes_core::tracker::{Tracker, TrackerConfig};
+use digiteyes_firmware::{Board, NoLed, Uploads};
+
+const FRAME_BYTES: usize = (WIDTH * HEIGHT) as usize;
+
+/// The mouse sub-model's free states (palm translation, finger 1, finger 4 and thumb).
+const FREE: [u8; 7] = [4, 5, 8, 9, 10, 19, 24];
+
+fn free_mask() -> u32 {
+    FREE.iter().map(|&s| 1u32 << s).sum()
+}
+
+fn configure(stats_every: u16, features_every: u16) -> HostMessage<'static> {
+    HostMessage::Configure(Configure {
+        camera: CameraParams::from_camera(&camera()).unwrap(),
+        tracker: TrackerParams::default(),
+        features_every,
+        stats_every,
+    })
+}
+
+fn reset(q: &[f32]) -> HostMessage<'static> {
+    HostMessage::Reset(Reset {
+        q: q.iter().copied().collect(),
+        free: free_mask(),
+    })
+}
+
+/// A board after boot, Configure and Reset, with the replies checked.
+fn ready_board<'m>(buffer: &'m mut [u8], q0: &[f32]) -> Board<'m, Pipe, Uploads, NoLed, StepClock> {
+    let mut board = Board::new(
+        "test",
+        buffer,
+        None,
+        Pipe::default(),
+        Uploads,
+        NoLed,
+        StepClock(0),
+    );
+    board.start().unwrap();
+    board.serial_mut().send(&configure(0, 0));
+    board.serial_mut().send(&reset(q0));
+    board.poll().unwrap();
+    let replies = board.serial_mut().received();
+    assert!(
+        matches!(
+            &replies[..],
+            [
+                BoardMessage::Hello(_),
+                BoardMessage::Ack(Command::Configure),
+                BoardMessage::Hello(_),
+                BoardMessage::Ack(Command::Reset)
+            ]
+        ),
+        "{replies:?}"
+    );
+    board
+}
+
+#[test]
+fn hello_names_the_board_and_its_model() {
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = Board::new(
+        "qemu-m7",
+        &mut buffer,
+        None,
+        Pipe::default(),
+        Uploads,
+        NoLed,
+        StepClock(0),
+    );
+    board.start().unwrap();
+    let [BoardMessage::Hello(hello)] = &board.serial_mut().received()[..] else {
+        panic!("one Hello at boot");
+    };
+    assert_eq!(hello.version, PROTOCOL_VERSION);
+    assert_eq!(hello.board.as_str(), "qemu-m7");
+    assert_eq!(hello.model_digest, model_digest(&Model::hand().unwrap()));
+    assert_eq!(hello.capacities.states, 28);
+    assert_eq!(hello.capacities.max_frame_bytes as usize, FRAME_BYTES);
+    assert_eq!(hello.clock_hz, 1_000_000);
+}
+
+#[test]
+fn uploaded_frames_give_the_in_process_trackers_states() {
+    let model = Model::hand().unwrap();
+    let cam = camera();
+    let q0 = pose(&model, 0.2);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = ready_board(&mut buffer, &q0);
+    let mut reference = Tracker::new(
+        model.clone(),
+        &[cam],
+        &q0,
+        Some(&FREE),
+        TrackerConfig::default(),
+    )
+    .unwrap();
+    for (n, bend) in [0.25f32, 0.3, 0.35, 0.4].into_iter().enumerate() {
+        let pixels = render(&model, &cam, &pose(&model, bend));
+        board
+            .serial_mut()
+            .send_frame(n as u32, WIDTH as u16, HEIGHT as u16, &pixels);
+        board.poll().unwrap();
+        let report = reference
+            .track(&[FrameView::packed(&pixels, WIDTH as usize, HEIGHT as usize).unwrap()])
+            .unwrap();
+        let [BoardMessage::State(state)] = &board.serial_mut().received()[..] else {
+            panic!("one State per frame");
+        };
+        assert_eq!(state.frame, n as u32);
+        assert_eq!(&state.q[..], reference.state(), "bit-exact states");
+        assert_eq!(state.rms_px.to_bits(), report.rms_px.to_bits());
+        assert_eq!(
+            (
+                state.lost,
+                state.features_found,
+                state.features_expected,
+                state.iterations
+            ),
+            (
+                report.lost,
+                report.features_found,
+                report.features_expected,
+                report.iterations
+            )
+        );
+        assert!(state.track_ticks > 0);
+        assert!(
+            report.features_found > 0,
+            "the synthetic frame shows the hand"
+        );
+    }
+    let stats = board.stats();
+    assert_eq!(
+        (stats.frames, stats.dropped, stats.bad_frames),
+        (4, DropCounts::default(), 0)
+    );
+}
+
+#[test]
+fn every_dropped_frame_is_reported_once_with_its_reason() {
+    let model = Model::hand().unwrap();
+    let q0 = pose(&model, 0.2);
+    let pixels = render(&model, &camera(), &q0);
+    let (w, h) = (WIDTH as u16, HEIGHT as u16);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = ready_board(&mut buffer, &q0);
+    let pipe = board.serial_mut();
+
+    // Wrong size: 2 px narrower.
+    pipe.send(&HostMessage::FrameChunk(FrameChunk {
+        frame: 1,
+        width: w - 2,
+        height: h,
+        offset: 0,
+        data: &pixels[..100],
+    }));
+    // A gap: the second chunk of frame 2 is missing.
+    pipe.send(&HostMessage::FrameChunk(FrameChunk {
+        frame: 2,
+        width: w,
+        height: h,
+        offset: 0,
+        data: &pixels[..1024],
+    }));
+    pipe.send(&HostMessage::FrameChunk(FrameChunk {
+        frame: 2,
+        width: w,
+        height: h,
+        offset: 2048,
+        data: &pixels[2048..3072],
+    }));
+    pipe.send(&HostMessage::FrameChunk(FrameChunk {
+        frame: 2,
+        width: w,
+        height: h,
+        offset: 3072,
+        data: &pixels[3072..4096],
+    }));
+    // Frame 3 half sent, then frame 4 whole: 3 is superseded, 4 tracked.
+    pipe.send(&HostMessage::FrameChunk(FrameChunk {
+        frame: 3,
+        width: w,
+        height: h,
+        offset: 0,
+        data: &pixels[..1024],
+    }));
+    pipe.send_frame(4, w, h, &pixels);
+    // A chunk running past the frame's end.
+    pipe.send(&HostMessage::FrameChunk(FrameChunk {
+        frame: 5,
+        width: w,
+        height: h,
+        offset: 0,
+        data: &pixels[..1024],
+    }));
+    let end = FRAME_BYTES as u32 - 10;
+    let long = &pixels[..1024];
+    board.poll().unwrap();
+    board
+        .serial_mut()
+        .send(&HostMessage::FrameChunk(FrameChunk {
+            frame: 5,
+            width: w,
+            height: h,
+            offset: 1024,
+            data: long,
+        }));
+    board
+        .serial_mut()
+        .send(&HostMessage::FrameChunk(FrameChunk {
+            frame: 6,
+            width: w,
+            height: h,
+            offset: end,
+            data: &long[..20],
+        }));
+    board.poll().unwrap();
+
+    let got = board.serial_mut().received();
+    let drops: Vec<(u32, DropReason)> = got
+        .iter()
+        .filter_map(|m| match m {
+            BoardMessage::Dropped(d) => Some((d.frame, d.reason)),
+            _ => None,
+        })
+        .collect();
+    let states: Vec<u32> = got
+        .iter()
+        .filter_map(|m| match m {
+            BoardMessage::State(s) => Some(s.frame),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        drops,
+        [
+            (1, DropReason::WrongSize(w - 2, h)),
+            (2, DropReason::Incomplete),
+            (3, DropReason::Superseded),
+            (5, DropReason::Superseded),
+            (6, DropReason::Incomplete),
+        ]
+    );
+    assert_eq!(states, [4]);
+    let stats = board.stats();
+    assert_eq!(stats.dropped.wrong_size, 1);
+    assert_eq!(stats.dropped.incomplete, 2);
+    assert_eq!(stats.dropped.superseded, 2);
+    assert_eq!(stats.bad_frames, 1);
+    assert_eq!(stats.frames, 1);
+}
+
+#[test]
+fn a_chunk_past_the_frames_end_is_too_large() {
+    let model = Model::hand().unwrap();
+    let q0 = pose(&model, 0.2);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = ready_board(&mut buffer, &q0);
+    let (w, h) = (WIDTH as u16, HEIGHT as u16);
+    let data = vec![7u8; 1000];
+    let pipe = board.serial_mut();
+    let mut offset = 0u32;
+    while offset as usize + 1000 < FRAME_BYTES {
+        pipe.send(&HostMessage::FrameChunk(FrameChunk {
+            frame: 9,
+            width: w,
+            height: h,
+            offset,
+            data: &data,
+        }));
+        offset += 1000;
+    }
+    // The frame has FRAME_BYTES - offset bytes left; send more than that.
+    pipe.send(&HostMessage::FrameChunk(FrameChunk {
+        frame: 9,
+        width: w,
+        height: h,
+        offset,
+        data: &data,
+    }));
+    board.poll().unwrap();
+    let got = board.serial_mut().received();
+    assert_eq!(
+        got,
+        [BoardMessage::Dropped(Dropped {
+            frame: 9,
+            reason: DropReason::TooLarge
+        })]
+    );
+    assert_eq!(board.stats().bad_frames, 1);
+}
+
+#[test]
+fn frames_before_configure_and_reset_are_not_ready() {
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = Board::new(
+        "t",
+        &mut buffer,
+        None,
+        Pipe::default(),
+        Uploads,
+        NoLed,
+        StepClock(0),
+    );
+    board
+        .serial_mut()
+        .send_frame(1, WIDTH as u16, HEIGHT as u16, &vec![0u8; FRAME_BYTES]);
+    board.serial_mut().send(&configure(0, 0));
+    board
+        .serial_mut()
+        .send_frame(2, WIDTH as u16, HEIGHT as u16, &vec![0u8; FRAME_BYTES]);
+    board.poll().unwrap();
+    let got = board.serial_mut().received();
+    assert_eq!(
+        got,
+        [
+            BoardMessage::Dropped(Dropped {
+                frame: 1,
+                reason: DropReason::NotReady
+            }),
+            BoardMessage::Ack(Command::Configure),
+            BoardMessage::Dropped(Dropped {
+                frame: 2,
+                reason: DropReason::NotReady
+            }),
+        ]
+    );
+    assert_eq!(board.stats().dropped.not_ready, 2);
+}
+
+#[test]
+fn bad_commands_are_refused_and_change_nothing() {
+    let model = Model::hand().unwrap();
+    let q0 = pose(&model, 0.2);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = Board::new(
+        "t",
+        &mut buffer,
+        None,
+        Pipe::default(),
+        Uploads,
+        NoLed,
+        StepClock(0),
+    );
+    let pipe = board.serial_mut();
+    pipe.send(&reset(&q0));
+    let mut cam = CameraParams::from_camera(&camera()).unwrap();
+    let good_cam = cam;
+    cam.intrinsics[0] = -1.0;
+    let mut params = TrackerParams::default();
+    pipe.send(&HostMessage::Configure(Configure {
+        camera: cam,
+        tracker: params,
+        features_every: 0,
+        stats_every: 0,
+    }));
+    params.iterations = 0;
+    pipe.send(&HostMessage::Configure(Configure {
+        camera: good_cam,
+        tracker: params,
+        features_every: 0,
+        stats_every: 0,
+    }));
+    let mut big = good_cam;
+    big.width *= 2;
+    pipe.send(&HostMessage::Configure(Configure {
+        camera: big,
+        tracker: TrackerParams::default(),
+        features_every: 0,
+        stats_every: 0,
+    }));
+    pipe.send(&configure(0, 0));
+    pipe.send(&HostMessage::Reset(Reset {
+        q: q0[..7].iter().copied().collect(),
+        free: free_mask(),
+    }));
+    let mut nan = q0.clone();
+    nan[9] = f32::NAN;
+    pipe.send(&reset(&nan));
+    pipe.send(&HostMessage::Reset(Reset {
+        q: q0.iter().copied().collect(),
+        free: 1 << 30,
+    }));
+    board.poll().unwrap();
+    let got = board.serial_mut().received();
+    assert_eq!(
+        got,
+        [
+            BoardMessage::Nak(Command::Reset, Refusal::NotConfigured),
+            BoardMessage::Nak(Command::Configure, Refusal::BadCamera),
+            BoardMessage::Nak(Command::Configure, Refusal::BadParameters),
+            BoardMessage::Nak(Command::Configure, Refusal::FrameTooLarge),
+            BoardMessage::Ack(Command::Configure),
+            BoardMessage::Nak(Command::Reset, Refusal::BadState),
+            BoardMessage::Nak(Command::Reset, Refusal::BadState),
+            BoardMessage::Nak(Command::Reset, Refusal::BadFreeMask),
+        ]
+    );
+}
+
+#[test]
+fn garbage_on_the_link_is_counted_and_the_next_frame_tracked() {
+    let model = Model::hand().unwrap();
+    let q0 = pose(&model, 0.2);
+    let pixels = render(&model, &camera(), &q0);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = ready_board(&mut buffer, &q0);
+    let pipe = board.serial_mut();
+    // Frame 1 with one byte flipped in its third chunk: that chunk fails its CRC, so the frame
+    // has a gap and is dropped; frame 2 arrives clean.
+    let start = pipe.to_board.len();
+    pipe.send_frame(1, WIDTH as u16, HEIGHT as u16, &pixels);
+    let third_chunk = start + 2 * (MAX_CHUNK + 20) + 100;
+    pipe.to_board[third_chunk] ^= 0x5a;
+    pipe.to_board.extend([0x11, 0x22, 0x33]);
+    pipe.send_frame(2, WIDTH as u16, HEIGHT as u16, &pixels);
+    pipe.send(&HostMessage::Ping(77));
+    board.poll().unwrap();
+    let got = board.serial_mut().received();
+    let [BoardMessage::Dropped(d), BoardMessage::State(s), BoardMessage::Stats(stats), BoardMessage::Pong(77)] =
+        &got[..]
+    else {
+        panic!("{got:?}");
+    };
+    assert_eq!((d.frame, d.reason), (1, DropReason::Incomplete));
+    assert_eq!(s.frame, 2);
+    assert_eq!(
+        stats.link.crc_errors + stats.link.framing_errors,
+        2,
+        "{stats:?}"
+    );
+    assert_eq!(stats.dropped.incomplete, 1);
+}
+
+#[test]
+fn a_camera_source_is_tracked_without_uploads() {
+    let model = Model::hand().unwrap();
+    let cam = camera();
+    let q0 = pose(&model, 0.2);
+    let frames = [0.22f32, 0.24, 0.26].map(|b| render(&model, &cam, &pose(&model, b)));
+    let source = Frames {
+        frames: frames.into_iter().collect(),
+        next: 0,
+    };
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = Board::new(
+        "cam",
+        &mut buffer,
+        None,
+        Pipe::default(),
+        source,
+        NoLed,
+        StepClock(0),
+    );
+    assert!(
+        !board.poll().unwrap(),
+        "nothing to do before Configure/Reset"
+    );
+    board.serial_mut().send(&configure(3, 0));
+    board.serial_mut().send(&reset(&q0));
+    while board.poll().unwrap() {}
+    let got = board.serial_mut().received();
+    let states: Vec<u32> = got
+        .iter()
+        .filter_map(|m| {
+            if let BoardMessage::State(s) = m {
+                Some(s.frame)
+            } else {
+                None
+            }
+        })
+        .collect();
+    assert_eq!(states, [100, 101, 102]);
+    assert!(matches!(got.last(), Some(BoardMessage::Stats(s)) if s.frames == 3));
+}
+
+#[test]
+fn features_are_sent_every_n_frames_and_name_links_in_view() {
+    let model = Model::hand().unwrap();
+    let cam = camera();
+    let q0 = pose(&model, 0.2);
+    let pixels = render(&model, &cam, &q0);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = Board::new(
+        "t",
+        &mut buffer,
+        None,
+        Pipe::default(),
+        Uploads,
+        NoLed,
+        StepClock(0),
+    );
+    board.serial_mut().send(&configure(0, 2));
+    board.serial_mut().send(&reset(&q0));
+    for n in 0..4 {
+        board
+            .serial_mut()
+            .send_frame(n, WIDTH as u16, HEIGHT as u16, &pixels);
+    }
+    board.poll().unwrap();
+    let features: Vec<Features> = board
+        .serial_mut()
+        .received()
+        .into_iter()
+        .filter_map(|m| {
+            if let BoardMessage::Features(f) = m {
+                Some(f)
+            } else {
+                None
+            }
+        })
+        .collect();
+    assert_eq!(features.iter().map(|f| f.frame).collect::<Vec<_>>(), [1, 3]);
+    let f = &features[0];
+    assert!(
+        f.links.iter().filter(|l| l.axis.is_some()).count() >= 8,
+        "{f:?}"
+    );
+    assert!(f.links.iter().any(|l| l.tip.is_some()));
+    // A measured axis lies close to the link's projected axis at the true state.
+    for l in f.links.iter() {
+        if let Some(axis) = l.axis {
+            let n = (axis.direction[0].powi(2) + axis.direction[1].powi(2)).sqrt();
+            assert!((n - 1.0).abs() < 1e-4);
+        }
+    }
+}
+
+#[test]
+fn the_overlay_draws_the_model_over_the_dimmed_frame() {
+    let model = Model::hand().unwrap();
+    let cam = camera();
+    let q0 = pose(&model, 0.2);
+    let pixels = render(&model, &cam, &q0);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut overlay = vec![0u8; FRAME_BYTES];
+    let mut board = Board::new(
+        "t",
+        &mut buffer,
+        Some(&mut overlay),
+        Pipe::default(),
+        Uploads,
+        NoLed,
+        StepClock(0),
+    );
+    assert!(board.overlay().is_none());
+    board.serial_mut().send(&configure(0, 0));
+    board.serial_mut().send(&reset(&q0));
+    board
+        .serial_mut()
+        .send_frame(0, WIDTH as u16, HEIGHT as u16, &pixels);
+    board.poll().unwrap();
+    let out = board.overlay().expect("an overlay after a tracked frame");
+    let edges = out.iter().filter(|&&p| p == 255).count();
+    let axes = out.iter().filter(|&&p| p == 160).count();
+    assert!(edges > 200 && axes > 100, "{edges} edge px, {axes} axis px");
+    let dimmed = out
+        .iter()
+        .zip(&pixels)
+        .filter(|(o, p)| **o == **p / 2)
+        .count();
+    assert!(dimmed > FRAME_BYTES * 3 / 4);
+}
