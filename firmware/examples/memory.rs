@@ -1,0 +1,56 @@
+//! Prints the static memory a board takes besides its frame buffers (bytes, this target):
+//! `cargo run -p digiteyes-firmware --example memory`. Figures are in docs/firmware.md.
+
+use core::mem::size_of;
+
+use digiteyes_core::model::Model;
+use digiteyes_core::protocol::{Decoder, MAX_MESSAGE};
+use digiteyes_core::tracker::Tracker;
+use digiteyes_firmware::{Board, Clock, NoLed, Uploads};
+
+struct NullSerial;
+impl embedded_io::ErrorType for NullSerial {
+    type Error = core::convert::Infallible;
+}
+impl embedded_io::Read for NullSerial {
+    fn read(&mut self, _: &mut [u8]) -> Result<usize, Self::Error> {
+        Ok(0)
+    }
+}
+impl embedded_io::ReadReady for NullSerial {
+    fn read_ready(&mut self) -> Result<bool, Self::Error> {
+        Ok(false)
+    }
+}
+impl embedded_io::Write for NullSerial {
+    fn write(&mut self, b: &[u8]) -> Result<usize, Self::Error> {
+        Ok(b.len())
+    }
+    fn flush(&mut self) -> Result<(), Self::Error> {
+        Ok(())
+    }
+}
+struct NullClock;
+impl Clock for NullClock {
+    fn ticks(&mut self) -> u64 {
+        0
+    }
+    fn hz(&self) -> u32 {
+        1
+    }
+}
+
+fn main() {
+    let board = size_of::<Board<'static, NullSerial, Uploads, NoLed, NullClock>>();
+    let tracker = size_of::<Tracker>();
+    let model = size_of::<Model>();
+    let decoder = size_of::<Decoder<MAX_MESSAGE>>();
+    println!("board (all but frame buffers): {board} B");
+    println!("  tracker (incl. its model and working memory): {tracker} B");
+    println!("  board's own copy of the model: {model} B");
+    println!("  receive buffer (decoder): {decoder} B");
+    println!("  transmit buffer: {MAX_MESSAGE} B");
+    for (name, w, h) in [("QQVGA", 160, 120), ("QVGA", 320, 240), ("VGA", 640, 480)] {
+        println!("frame buffer {name} {w}x{h}: {} B (+ the same again for an overlay)", w * h);
+    }
+}
