@@ -12,7 +12,7 @@
 //! - **tip** (Eq. 2.19): the distance along the axis between the predicted and found tip.
 
 use heapless::Vec;
-use nalgebra::{SMatrix, SVector, Vector2};
+use nalgebra::{SVector, Vector2};
 
 use crate::camera::Camera;
 use crate::config::{MAX_ROW_NONZEROS, MAX_STATES};
@@ -195,11 +195,38 @@ impl LinkJacobian {
     }
 }
 
+/// Where state `s` is stored in [`NormalEquations`]: the joints (`q7`...) first, the palm
+/// states last. Every row involves the palm and one joint chain, so in this order `JᵀWJ` is
+/// block-arrowhead and its factor has no fill outside the rows' envelope.
+fn position(s: usize) -> usize {
+    (s + MAX_STATES - BASE_STATES) % MAX_STATES
+}
+
+/// The state stored at position `p` (the inverse of [`position`]).
+fn state_at(p: usize) -> usize {
+    (p + BASE_STATES) % MAX_STATES
+}
+
+/// Entries strictly below the diagonal of a `MAX_STATES` square, packed by rows.
+const LOWER: usize = MAX_STATES * (MAX_STATES - 1) / 2;
+
+/// Index in a packed strict lower triangle of element (`hi`, `lo`), `hi > lo`.
+fn packed(hi: usize, lo: usize) -> usize {
+    hi * (hi - 1) / 2 + lo
+}
+
 /// The normal equations `JᵀWJ`, `JᵀWr` accumulated row by row, with residual statistics.
+///
+/// Kept as a packed triangle (under 2 KiB, so clearing it each iteration is a few vector
+/// stores rather than a long `rep stos`).
 #[derive(Debug, Clone)]
 pub struct NormalEquations {
-    jtj: SMatrix<f32, MAX_STATES, MAX_STATES>,
-    jtr: SVector<f32, MAX_STATES>,
+    /// Strict lower triangle of `JᵀWJ`, rows and columns in [`position`] order, packed.
+    lower: [f32; LOWER],
+    /// Diagonal of `JᵀWJ` in [`position`] order.
+    diag: [f32; MAX_STATES],
+    /// `JᵀWr` in [`position`] order.
+    jtr: [f32; MAX_STATES],
     sum_squares: f32,
     rows: u16,
 }
@@ -214,8 +241,9 @@ impl NormalEquations {
     /// Empty equations.
     pub fn new() -> Self {
         NormalEquations {
-            jtj: SMatrix::zeros(),
-            jtr: SVector::zeros(),
+            lower: [0.0; LOWER],
+            diag: [0.0; MAX_STATES],
+            jtr: [0.0; MAX_STATES],
             sum_squares: 0.0,
             rows: 0,
         }
@@ -223,10 +251,29 @@ impl NormalEquations {
 
     /// Clears for the next iteration.
     pub fn clear(&mut self) {
-        self.jtj = SMatrix::zeros();
-        self.jtr = SVector::zeros();
+        self.lower = [0.0; LOWER];
+        self.diag = [0.0; MAX_STATES];
+        self.jtr = [0.0; MAX_STATES];
         self.sum_squares = 0.0;
         self.rows = 0;
+    }
+
+    /// Adds `v` to element (`si`, `sj`) of `JᵀWJ` (states; either order).
+    fn add_at(&mut self, si: usize, sj: usize, v: f32) {
+        let (pi, pj) = (position(si), position(sj));
+        let cell = match pi.cmp(&pj) {
+            core::cmp::Ordering::Equal => self.diag.get_mut(pi),
+            core::cmp::Ordering::Greater => self.lower.get_mut(packed(pi, pj)),
+            core::cmp::Ordering::Less => self.lower.get_mut(packed(pj, pi)),
+        };
+        if let Some(cell) = cell {
+            *cell += v;
+        }
+    }
+
+    /// Element (`pi`, `pj`) of `JᵀWJ` by positions, `pi > pj`.
+    fn below(&self, pi: usize, pj: usize) -> f32 {
+        self.lower.get(packed(pi, pj)).copied().unwrap_or(0.0)
     }
 
     /// Adds one residual `r` (px) with derivative entries `(state, ∂r/∂q_state)` and weight
@@ -240,7 +287,7 @@ impl NormalEquations {
         if w == 0.0 {
             return;
         }
-        // Keep the free entries once, then a plain rank-1 update of the upper triangle.
+        // Keep the free entries once, then a plain rank-1 update of the triangle.
         let mut index = [0usize; MAX_ROW_NONZEROS];
         let mut value = [0.0f32; MAX_ROW_NONZEROS];
         let mut n = 0;
@@ -252,17 +299,11 @@ impl NormalEquations {
                 n += 1;
             }
         }
-        let jtj = self.jtj.as_mut_slice();
         for a in 0..n {
             let (ia, wv) = (index[a], w * value[a]);
-            self.jtr[ia] += wv * r;
+            self.jtr[position(ia)] += wv * r;
             for b in a..n {
-                let ib = index[b];
-                let (lo, hi) = if ia <= ib { (ia, ib) } else { (ib, ia) };
-                // Column-major: element (lo, hi) of the upper triangle.
-                if let Some(cell) = jtj.get_mut(hi * MAX_STATES + lo) {
-                    *cell += wv * value[b];
-                }
+                self.add_at(ia, index[b], wv * value[b]);
             }
         }
     }
@@ -283,6 +324,10 @@ impl NormalEquations {
 
     /// The conditioned Gauss–Newton step `−(JᵀWJ + S)⁻¹ JᵀWr` for the free states (zero for
     /// the others), or `None` if the system is not positive definite or not finite.
+    ///
+    /// Solved over the free states only, by an `LDLᵀ` factorisation (no square roots) that
+    /// works within each row's envelope: in the joints-then-palm order a joint's row is zero
+    /// left of its chain's first joint, and the factor keeps that profile.
     #[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
     pub fn step(
         &self,
@@ -290,20 +335,83 @@ impl NormalEquations {
         free: FreeMask,
         conditioning: &Conditioning,
     ) -> Option<SVector<f32, MAX_STATES>> {
-        let mut a = self.jtj;
-        let mut b = self.jtr;
-        for i in 0..MAX_STATES {
-            for j in 0..i {
-                a[(i, j)] = a[(j, i)];
-            }
-            if i < n_states && free.contains(i) {
-                a[(i, i)] += conditioning.for_state(i);
-            } else {
-                a[(i, i)] = 1.0;
-                b[i] = 0.0;
+        // The free states, in storage order: `at[i]` is the position of the i-th.
+        let mut at = [0usize; MAX_STATES];
+        let mut m = 0;
+        for p in 0..MAX_STATES {
+            let s = state_at(p);
+            if s < n_states && free.contains(s) {
+                at[m] = p;
+                m += 1;
             }
         }
-        let delta = -a.cholesky()?.solve(&b);
+        let at = &at[..m];
+        // The compact system, packed by rows like `lower`: each row's envelope (from its first
+        // non-zero) in `l`, the diagonal in `d`.
+        let mut l = [0.0f32; LOWER];
+        let mut first = [0usize; MAX_STATES];
+        let mut d = [0.0f32; MAX_STATES];
+        let mut b = [0.0f32; MAX_STATES];
+        for (i, &pi) in at.iter().enumerate() {
+            let f = at[..i]
+                .iter()
+                .position(|&pj| self.below(pi, pj) != 0.0)
+                .unwrap_or(i);
+            first[i] = f;
+            let row = packed(i.max(1), 0);
+            for (j, &pj) in at.iter().enumerate().take(i).skip(f) {
+                l[row + j] = self.below(pi, pj);
+            }
+            d[i] = self.diag[pi] + conditioning.for_state(state_at(pi));
+            b[i] = self.jtr[pi];
+        }
+        // LDLᵀ, row by row: `l` becomes the unit lower factor, `d` the pivots.
+        let mut w = [0.0f32; MAX_STATES]; // L[i][k]·D[k] of the row being factored
+        let mut inv_d = [0.0f32; MAX_STATES];
+        for i in 0..m {
+            let fi = first[i];
+            let row = packed(i.max(1), 0);
+            for j in fi..i {
+                let from = first[j].max(fi);
+                let row_j = packed(j.max(1), 0);
+                let mut t = l[row + j];
+                for (wk, ljk) in w[from..j].iter().zip(&l[row_j + from..row_j + j]) {
+                    t -= wk * ljk;
+                }
+                w[j] = t;
+                l[row + j] = t * inv_d[j];
+            }
+            let mut pivot = d[i];
+            for (wk, lik) in w[fi..i].iter().zip(&l[row + fi..row + i]) {
+                pivot -= wk * lik;
+            }
+            if !(pivot > 0.0 && pivot.is_finite()) {
+                return None;
+            }
+            inv_d[i] = 1.0 / pivot;
+        }
+        // L y = b, then Lᵀ x = D⁻¹ y.
+        for i in 0..m {
+            let (fi, row) = (first[i], packed(i.max(1), 0));
+            let mut t = b[i];
+            for (lik, yk) in l[row + fi..row + i].iter().zip(&b[fi..i]) {
+                t -= lik * yk;
+            }
+            b[i] = t;
+        }
+        for (y, inv) in b.iter_mut().zip(&inv_d).take(m) {
+            *y *= inv;
+        }
+        for i in (0..m).rev() {
+            let (fi, row, xi) = (first[i], packed(i.max(1), 0), b[i]);
+            for (xk, lik) in b[fi..i].iter_mut().zip(&l[row + fi..row + i]) {
+                *xk -= lik * xi;
+            }
+        }
+        let mut delta = SVector::<f32, MAX_STATES>::zeros();
+        for (&p, x) in at.iter().zip(&b) {
+            delta[state_at(p)] = -x;
+        }
         delta.iter().all(|v| v.is_finite()).then_some(delta)
     }
 }
@@ -379,12 +487,11 @@ impl LinkBlock {
             if !free.contains(si) || si >= MAX_STATES {
                 continue;
             }
-            ne.jtr[si] += self.jtr[i];
+            ne.jtr[position(si)] += self.jtr[i];
             for (j, &sj) in states.iter().enumerate().take(self.n).skip(i) {
                 let sj = usize::from(sj);
                 if free.contains(sj) && sj < MAX_STATES {
-                    let (lo, hi) = if si <= sj { (si, sj) } else { (sj, si) };
-                    ne.jtj[(lo, hi)] += self.jtj[i][j];
+                    ne.add_at(si, sj, self.jtj[i][j]);
                 }
             }
         }
