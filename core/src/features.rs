@@ -35,8 +35,13 @@ pub enum Polarity {
 pub struct FeatureConfig {
     /// Slices per link (at most [`MAX_SLICES_PER_LINK`]).
     pub slices_per_link: u8,
-    /// Search window along each slice and beyond each tip (px, at most [`MAX_WINDOW`]).
+    /// Search window along each slice and beyond each tip (px, at most [`MAX_WINDOW`]), in
+    /// a frame's first iteration.
     pub window_px: u8,
+    /// Coarse to fine: in a frame's later iterations the tracker narrows each link's window
+    /// to what its last search needed, [`LinkFeatures::reach_px`] plus this margin on each
+    /// side (px); infinite keeps `window_px` throughout.
+    pub refine_margin_px: f32,
     /// Smallest derivative peak accepted as an edge (grey levels per px).
     pub min_contrast: f32,
     /// Slices are spread over this part of the axis (fractions of its length).
@@ -56,6 +61,7 @@ impl Default for FeatureConfig {
         FeatureConfig {
             slices_per_link: 5,
             window_px: 20,
+            refine_margin_px: 1.0,
             min_contrast: 4.0,
             span: [0.15, 0.85],
             min_link_px: 6.0,
@@ -192,6 +198,8 @@ pub struct LinkFeatures {
     pub masked: u16,
     /// Slices and tip windows that left the frame.
     pub off_frame: u16,
+    /// Farthest any edge or tip found lies from its prediction (px); 0 when none was found.
+    pub reach_px: f32,
 }
 
 /// Unit axis direction and normal `(−d_y, d_x)` of a link in the image.
@@ -221,6 +229,7 @@ pub fn find_link_features(
     out.expected = 0;
     out.masked = 0;
     out.off_frame = 0;
+    out.reach_px = 0.0;
     let Some(link) = view.links.get(index) else {
         return;
     };
@@ -295,6 +304,7 @@ pub fn find_link_features(
         } else {
             find_edge(&profile[..window], config.polarity, config.min_contrast)?
         };
+        out.reach_px = out.reach_px.max((edge.position - half).abs());
         Some((start + outward * edge.position, edge.strength))
     };
     for k in 0..slices {

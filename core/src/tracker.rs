@@ -10,7 +10,7 @@ use core::fmt;
 use heapless::Vec;
 
 use crate::camera::{Camera, CameraError};
-use crate::config::{MAX_CAMERAS, MAX_STATES};
+use crate::config::{MAX_CAMERAS, MAX_FRAMES, MAX_STATES};
 use crate::estimator::{
     add_link_rows, apply_step, EstimatorConfig, FreeMask, LinkJacobian, NormalEquations,
 };
@@ -120,6 +120,9 @@ struct Workspace {
     features: LinkFeatures,
     jacobian: LinkJacobian,
     normal: NormalEquations,
+    /// `reach[camera][frame]`: what the last search of link `frame` in this frame needed
+    /// ([`LinkFeatures::reach_px`]), infinite when unknown; sizes the next window.
+    reach: [[f32; MAX_FRAMES]; MAX_CAMERAS],
 }
 
 /// Tracks one hand over frames from one or more calibrated cameras.
@@ -184,6 +187,7 @@ impl Tracker {
                 features: LinkFeatures::default(),
                 jacobian: LinkJacobian::default(),
                 normal: NormalEquations::new(),
+                reach: [[f32::INFINITY; MAX_FRAMES]; MAX_CAMERAS],
             },
         };
         tracker.reset(initial)?;
@@ -247,8 +251,9 @@ impl Tracker {
         let start = self.state.clone();
         let mut q = self.predicted();
         let mut report = FrameReport::default();
-        for _ in 0..self.config.iterations.max(1) {
-            let Some(step) = self.iterate(&q, frames, &mut report) else {
+        self.work.reach = [[f32::INFINITY; MAX_FRAMES]; MAX_CAMERAS];
+        for k in 0..self.config.iterations.max(1) {
+            let Some(step) = self.iterate(&q, frames, k > 0, &mut report) else {
                 report.lost = true;
                 break;
             };
@@ -295,6 +300,7 @@ impl Tracker {
         &mut self,
         q: &[f32],
         frames: &[FrameView<'_>],
+        refine: bool,
         report: &mut FrameReport,
     ) -> Option<nalgebra::SVector<f32, MAX_STATES>> {
         let work = &mut self.work;
@@ -305,11 +311,12 @@ impl Tracker {
         report.features_masked = 0;
         report.links_skipped = 0;
         let config = &self.config;
-        for ((camera, frame), view) in self
+        for (((camera, frame), view), reach) in self
             .cameras
             .iter()
             .zip(frames.iter())
             .zip(work.views.iter_mut())
+            .zip(work.reach.iter_mut())
         {
             view.update(
                 &self.model,
@@ -320,19 +327,29 @@ impl Tracker {
             let skipped = view.skipped;
             report.links_skipped += skipped.behind + skipped.end_on + skipped.off_frame;
             for index in 0..view.links.len() {
-                find_link_features(
-                    view,
-                    camera,
-                    frame,
-                    index,
-                    &config.features,
-                    &mut work.features,
-                );
+                let frame_index = usize::from(view.links[index].frame);
+                let mut features = config.features;
+                if refine {
+                    // Coarse to fine: the window this link's last search needed, plus margin.
+                    let reach = reach.get(frame_index).copied().unwrap_or(f32::INFINITY);
+                    let need = 2.0 * (reach + features.refine_margin_px) + 7.0;
+                    if need < f32::from(features.window_px) {
+                        features.window_px = libm::ceilf(need) as u8;
+                    }
+                }
+                find_link_features(view, camera, frame, index, &features, &mut work.features);
                 let found =
                     work.features.edges.len() as u16 + u16::from(work.features.tip.is_some());
                 report.features_found += found;
                 report.features_expected += work.features.expected;
                 report.features_masked += work.features.masked;
+                if let Some(r) = reach.get_mut(frame_index) {
+                    *r = if found == 0 {
+                        f32::INFINITY
+                    } else {
+                        work.features.reach_px
+                    };
+                }
                 if found == 0 {
                     continue;
                 }
