@@ -428,35 +428,40 @@ pub struct LinkRows {
     pub tips: u16,
 }
 
-/// Width of a link's dense block: [`MAX_ROW_NONZEROS`] rounded up to a multiple of 4, so the
-/// row loops have a fixed length the compiler turns into SIMD.
-const BLOCK: usize = MAX_ROW_NONZEROS.div_ceil(4) * 4;
+/// The image parameters of a link that every residual depends on: `a.x, a.y, b.x, b.y, r0,
+/// r1` (the axis ends and the projected radii at them, px).
+const PARAMS: usize = 6;
 
-/// The normal equations of one link's rows over the link's own states (`jac.states`, at most
-/// [`MAX_ROW_NONZEROS`]): dense and small, added to the 32×32 system once per link.
+/// One link's rows, gathered in the link's six image parameters.
+///
+/// Every residual of a link (edge point, axis point, axis line, tip) is a linear function of
+/// the derivatives of its image parameters, `∂r/∂q = cᵀ G` with `G` the 6×n matrix of
+/// [`LinkJacobian`] (`∂a`, `∂b`, `∂r0`, `∂r1` by each state) and `c` six coefficients that
+/// depend on the row alone. So the link's `JᵀWJ = Gᵀ (Σ w c cᵀ) G` and `JᵀWr = Gᵀ Σ w r c`:
+/// each row costs a 6×6 rank-1 update, and `G` is applied once per link.
 struct LinkBlock {
-    n: usize,
-    jtj: [[f32; BLOCK]; BLOCK],
-    jtr: [f32; BLOCK],
+    /// `Σ w c cᵀ`.
+    cc: [[f32; PARAMS]; PARAMS],
+    /// `Σ w r c`.
+    cr: [f32; PARAMS],
     sum_squares: f32,
     rows: u16,
 }
 
 impl LinkBlock {
-    fn new(n: usize) -> Self {
+    fn new() -> Self {
         LinkBlock {
-            n: n.min(MAX_ROW_NONZEROS),
-            jtj: [[0.0; BLOCK]; BLOCK],
-            jtr: [0.0; BLOCK],
+            cc: [[0.0; PARAMS]; PARAMS],
+            cr: [0.0; PARAMS],
             sum_squares: 0.0,
             rows: 0,
         }
     }
 
-    /// As [`NormalEquations::add_row`], with `values[k]` the derivative by `jac.states[k]`
-    /// (entries from `n` on are zero).
-    fn add(&mut self, values: &[f32; BLOCK], r: f32, w: f32) {
-        let finite = values.iter().fold(true, |ok, v| ok & v.is_finite());
+    /// Adds the row `cᵀ G` with residual `r` (px) and weight `w`; non-finite rows are
+    /// ignored, as [`NormalEquations::add_row`] does.
+    fn add(&mut self, c: &[f32; PARAMS], r: f32, w: f32) {
+        let finite = c.iter().fold(true, |ok, v| ok & v.is_finite());
         if !(r.is_finite() && w.is_finite() && finite) {
             return;
         }
@@ -465,99 +470,111 @@ impl LinkBlock {
         if w == 0.0 {
             return;
         }
-        // The full square (not the triangle): fixed-length rows vectorise.
-        for (i, (row, rhs)) in self.jtj.iter_mut().zip(self.jtr.iter_mut()).enumerate() {
-            if i >= self.n {
-                break;
-            }
-            let wv = w * values[i];
-            *rhs += wv * r;
-            for (a, v) in row.iter_mut().zip(values) {
-                *a += wv * v;
+        for (row, (rhs, &ci)) in self.cc.iter_mut().zip(self.cr.iter_mut().zip(c)) {
+            let wc = w * ci;
+            *rhs += wc * r;
+            for (a, v) in row.iter_mut().zip(c) {
+                *a += wc * v;
             }
         }
     }
 
-    /// Adds the block's upper triangle to `ne`, dropping states that are not free.
-    fn scatter(&self, ne: &mut NormalEquations, states: &[u8], free: FreeMask) {
+    /// Adds `Gᵀ (Σ w c cᵀ) G` and `Gᵀ Σ w r c` to `ne`, over the link's free states. If `G`
+    /// is not finite every row would have been, and nothing is added.
+    fn scatter(&self, ne: &mut NormalEquations, jac: &LinkJacobian, free: FreeMask) {
+        // `G` by rows over the link's free states (zero-padded to a fixed width, so every
+        // loop below is a fixed-length vector operation).
+        let mut pos = [0usize; MAX_ROW_NONZEROS];
+        let mut g = [[0.0f32; BLOCK]; PARAMS];
+        let mut n = 0;
+        let columns = jac
+            .states
+            .iter()
+            .zip(jac.da.iter().zip(&jac.db))
+            .zip(jac.dr0.iter().zip(&jac.dr1));
+        for ((&s, (da, db)), (&dr0, &dr1)) in columns {
+            let s = usize::from(s);
+            if s < MAX_STATES && free.contains(s) && n < MAX_ROW_NONZEROS {
+                pos[n] = position(s);
+                for (row, v) in g.iter_mut().zip([da.x, da.y, db.x, db.y, dr0, dr1]) {
+                    row[n] = v;
+                }
+                n += 1;
+            }
+        }
+        // `v·0` is 0 for a finite `v` and NaN otherwise: one vectorisable sum tests all.
+        let zero: f32 = g.iter().flatten().map(|v| v * 0.0).sum();
+        if zero != 0.0 {
+            return;
+        }
         ne.sum_squares += self.sum_squares;
         ne.rows = ne.rows.saturating_add(self.rows);
-        for i in 0..self.n {
-            let si = usize::from(states[i]);
-            if !free.contains(si) || si >= MAX_STATES {
-                continue;
+        // (Σ w c cᵀ) G and Gᵀ Σ w r c.
+        let axpy = |out: &mut [f32; BLOCK], a: f32, x: &[f32; BLOCK]| {
+            for (o, v) in out.iter_mut().zip(x) {
+                *o += a * v;
             }
-            ne.jtr[position(si)] += self.jtr[i];
-            for (j, &sj) in states.iter().enumerate().take(self.n).skip(i) {
-                let sj = usize::from(sj);
-                if free.contains(sj) && sj < MAX_STATES {
-                    ne.add_at(si, sj, self.jtj[i][j]);
+        };
+        let mut cg = [[0.0f32; BLOCK]; PARAMS];
+        for (out, cc) in cg.iter_mut().zip(&self.cc) {
+            for (&c, row) in cc.iter().zip(&g) {
+                axpy(out, c, row);
+            }
+        }
+        let mut rhs = [0.0f32; BLOCK];
+        for (&c, row) in self.cr.iter().zip(&g) {
+            axpy(&mut rhs, c, row);
+        }
+        // Row i of Gᵀ (C G), added into the triangle from the diagonal on.
+        for i in 0..n {
+            let mut h = [0.0f32; BLOCK];
+            for (row, cg_row) in g.iter().zip(&cg) {
+                axpy(&mut h, row[i], cg_row);
+            }
+            let pi = pos[i];
+            if let (Some(v), Some(d)) = (ne.jtr.get_mut(pi), ne.diag.get_mut(pi)) {
+                *v += rhs[i];
+                *d += h[i];
+            }
+            for (&pj, hj) in pos[i + 1..n].iter().zip(&h[i + 1..n]) {
+                let (lo, hi) = if pi < pj { (pi, pj) } else { (pj, pi) };
+                if let Some(v) = ne.lower.get_mut(packed(hi.max(1), lo)) {
+                    *v += hj;
                 }
             }
         }
     }
-
-    fn add_row(&mut self, row: &Row, r: f32, w: f32) {
-        let mut values = [0.0; BLOCK];
-        for (v, (_, d)) in values.iter_mut().zip(row.iter()) {
-            *v = *d;
-        }
-        self.add(&values, r, w);
-    }
 }
 
-/// What every edge row of one link shares (see [`edge_row`]), computed once per link: each
-/// row is then a fixed-length combination of these per-state vectors.
+/// Width of the per-link rows of `G`: [`MAX_ROW_NONZEROS`] rounded up to a multiple of 4, so
+/// the loops over them have a fixed length the compiler turns into SIMD.
+const BLOCK: usize = MAX_ROW_NONZEROS.div_ceil(4) * 4;
+
+/// What every edge row of one link shares, computed once per link (see [`edge_row`]).
 struct EdgeBasis {
     normal: Vector2<f32>,
     axis: Vector2<f32>,
     len2: f32,
     taper: [f32; 2],
-    nda: [f32; BLOCK],
-    ndb: [f32; BLOCK],
-    dax: [f32; BLOCK],
-    day: [f32; BLOCK],
-    ds0: [f32; BLOCK],
-    ds1: [f32; BLOCK],
-    dr0: [f32; BLOCK],
-    dr1: [f32; BLOCK],
 }
 
 impl EdgeBasis {
-    fn new(link: &ProjectedLink, jac: &LinkJacobian) -> Self {
+    fn new(link: &ProjectedLink) -> Self {
         let (_, normal) = axis_frame(&link.a, &link.b);
         let axis = link.b - link.a;
-        let mut b = EdgeBasis {
+        EdgeBasis {
             normal,
             axis,
             len2: axis.norm_squared().max(1e-9),
             taper: [1i8, -1]
                 .map(|side| link.side_radius_at(1.0, side) - link.side_radius_at(0.0, side)),
-            nda: [0.0; BLOCK],
-            ndb: [0.0; BLOCK],
-            dax: [0.0; BLOCK],
-            day: [0.0; BLOCK],
-            ds0: [0.0; BLOCK],
-            ds1: [0.0; BLOCK],
-            dr0: [0.0; BLOCK],
-            dr1: [0.0; BLOCK],
-        };
-        for k in 0..jac.states.len().min(MAX_ROW_NONZEROS) {
-            let d_axis = jac.db[k] - jac.da[k];
-            b.nda[k] = normal.dot(&jac.da[k]);
-            b.ndb[k] = normal.dot(&jac.db[k]);
-            b.dax[k] = d_axis.x;
-            b.day[k] = d_axis.y;
-            b.ds0[k] = jac.da[k].dot(&axis);
-            b.ds1[k] = axis.dot(&d_axis);
-            b.dr0[k] = jac.dr0[k];
-            b.dr1[k] = jac.dr1[k];
         }
-        b
     }
 
-    /// [`edge_row`]'s derivatives (by `jac.states[k]`, zero beyond) and [`edge_residual`].
-    fn row(&self, link: &ProjectedLink, e: &EdgePoint) -> ([f32; BLOCK], f32) {
+    /// [`edge_row`] as coefficients of the link's image parameters, and [`edge_residual`].
+    /// The row is `σ n·((1−s) ∂a + s ∂b) + (1−s) ∂r0 + s ∂r1 + t ∂s` with
+    /// `∂s·len² = rel·(∂b − ∂a) − axis·∂a − 2 s_raw axis·(∂b − ∂a)`.
+    fn row(&self, link: &ProjectedLink, e: &EdgePoint) -> ([f32; PARAMS], f32) {
         let rel = e.position - link.a;
         let raw_s = rel.dot(&self.axis) / self.len2;
         let s = raw_s.clamp(0.0, 1.0);
@@ -567,17 +584,22 @@ impl EdgeBasis {
         } else {
             0.0
         };
-        let mut values = [0.0f32; BLOCK];
-        for (k, v) in values.iter_mut().enumerate() {
-            let ds =
-                rel.x * self.dax[k] + rel.y * self.day[k] - self.ds0[k] - 2.0 * raw_s * self.ds1[k];
-            *v = side * ((1.0 - s) * self.nda[k] + s * self.ndb[k])
-                + (1.0 - s) * self.dr0[k]
-                + s * self.dr1[k]
-                + t * ds;
-        }
+        let (n, axis) = (self.normal, self.axis);
+        let (u, v) = (side * (1.0 - s), side * s);
+        let tb = Vector2::new(
+            t * (rel.x - 2.0 * raw_s * axis.x),
+            t * (rel.y - 2.0 * raw_s * axis.y),
+        );
+        let c = [
+            u * n.x - tb.x - t * axis.x,
+            u * n.y - tb.y - t * axis.y,
+            v * n.x + tb.x,
+            v * n.y + tb.y,
+            1.0 - s,
+            s,
+        ];
         let r = link.side_radius_at(s, e.side) - side * self.normal.dot(&rel);
-        (values, r)
+        (c, r)
     }
 }
 
@@ -595,20 +617,18 @@ pub fn add_link_rows(
     if jac.states.is_empty() {
         return added;
     }
-    let n = jac.states.len().min(MAX_ROW_NONZEROS);
-    let mut block = LinkBlock::new(n);
-    let mut row = Row::new();
+    let mut block = LinkBlock::new();
     match config.residual {
         ResidualKind::EdgePoints => {
-            let basis = EdgeBasis::new(link, jac);
+            let basis = EdgeBasis::new(link);
             for e in &features.edges {
-                let (values, r) = basis.row(link, e);
-                block.add(&values, r, config.robust.weight(r));
+                let (c, r) = basis.row(link, e);
+                block.add(&c, r, config.robust.weight(r));
                 added.edges += 1;
             }
         }
         ResidualKind::AxisPoints => {
-            let basis = EdgeBasis::new(link, jac);
+            let basis = EdgeBasis::new(link);
             let edges = &features.edges;
             let mut i = 0;
             while i < edges.len() {
@@ -616,7 +636,7 @@ pub fn add_link_rows(
                 let partner = edges
                     .get(i + 1)
                     .filter(|o| o.side == -e.side && (o.s - e.s).abs() < 1e-6);
-                let (values, r) = match partner {
+                let (c, r) = match partner {
                     Some(o) => {
                         let (mut plus, r_plus) = basis.row(link, e);
                         let (minus, r_minus) = basis.row(link, o);
@@ -632,26 +652,32 @@ pub fn add_link_rows(
                         basis.row(link, e)
                     }
                 };
-                block.add(&values, r, config.robust.weight(r));
+                block.add(&c, r, config.robust.weight(r));
                 added.edges += 1;
             }
         }
         ResidualKind::AxisLines => {
-            if let Some(line) = fit_axis_line(link, features) {
-                for end in [0, 1] {
-                    let r = line_row(link, jac, line, end, &mut row);
-                    block.add_row(&row, r, 1.0);
+            if let Some((centre, line_normal)) = fit_axis_line(link, features) {
+                // Eq. 2.17, as `line_row`: `n·∂a` and `n·∂b`.
+                for (end, point) in [link.a, link.b].iter().enumerate() {
+                    let mut c = [0.0; PARAMS];
+                    c[2 * end] = line_normal.x;
+                    c[2 * end + 1] = line_normal.y;
+                    block.add(&c, line_normal.dot(&(point - centre)), 1.0);
                     added.edges += 1;
                 }
             }
         }
     }
     if let Some(tip) = features.tip {
-        let r = tip_row(link, jac, &tip, &mut row);
-        block.add_row(&row, r, config.tip_weight * config.robust.weight(r));
+        // Eq. 2.19, as `tip_row`: `dir·∂b + ∂r1`.
+        let (dir, _) = axis_frame(&link.a, &link.b);
+        let r = dir.dot(&(link.b - tip)) + link.tip_offset;
+        let c = [0.0, 0.0, dir.x, dir.y, 0.0, 1.0];
+        block.add(&c, r, config.tip_weight * config.robust.weight(r));
         added.tips += 1;
     }
-    block.scatter(ne, &jac.states, free);
+    block.scatter(ne, jac, free);
     added
 }
 
