@@ -375,8 +375,12 @@ impl NormalEquations {
                 let from = first[j].max(fi);
                 let row_j = packed(j.max(1), 0);
                 let mut t = l[row + j];
-                for (wk, ljk) in w[from..j].iter().zip(&l[row_j + from..row_j + j]) {
-                    t -= wk * ljk;
+                // Mostly 0–4 terms (a joint's chain) or a whole row (palm by palm): a plain
+                // indexed loop, without an iterator's set-up.
+                let mut k = from;
+                while k < j {
+                    t -= w[k] * l[row_j + k];
+                    k += 1;
                 }
                 w[j] = t;
                 l[row + j] = t * inv_d[j];

@@ -238,8 +238,6 @@ pub fn find_link_features(
     let (dir, normal) = axis_frame(&link.a, &link.b);
     let slices = usize::from(config.slices_per_link).clamp(1, MAX_SLICES_PER_LINK);
     let mut profile = [0.0f32; MAX_WINDOW];
-    // Every point `cover` is asked about (the predicted edges and tip, and 2 px beyond each),
-    // boxed, so only the links and palm whose bounds meet the box are tested.
     let slice_s = |k: usize| {
         if slices == 1 {
             0.5 * (config.span[0] + config.span[1])
@@ -247,28 +245,20 @@ pub fn find_link_features(
             config.span[0] + (config.span[1] - config.span[0]) * k as f32 / (slices - 1) as f32
         }
     };
+    // Every point `cover` is asked about (the predicted edges and tip, and 2 px beyond each)
+    // lies within the link's own bounds grown by 2 px, so only the links and palm whose
+    // bounds meet that box are tested.
     let (among, palm) = if config.mask_occluded {
-        let mut region = Bounds {
-            min: Vector2::new(f32::INFINITY, f32::INFINITY),
-            max: Vector2::new(f32::NEG_INFINITY, f32::NEG_INFINITY),
+        let reach = Vector2::new(2.0, 2.0);
+        let tip = if config.tips && link.distal {
+            link.b + dir * (link.tip_offset + 2.0)
+        } else {
+            link.b
         };
-        let mut grow = |p: Vector2<f32>, outward: Vector2<f32>| {
-            for q in [p, p + outward * 2.0] {
-                region.min = region.min.inf(&q);
-                region.max = region.max.sup(&q);
-            }
+        let region = Bounds {
+            min: (link.bounds.min - reach).inf(&tip),
+            max: (link.bounds.max + reach).sup(&tip),
         };
-        for k in 0..slices {
-            let s = slice_s(k);
-            let axis_point = link.a + (link.b - link.a) * s;
-            for side in [1i8, -1] {
-                let outward = normal * f32::from(side);
-                grow(axis_point + outward * link.side_radius_at(s, side), outward);
-            }
-        }
-        if config.tips && link.distal {
-            grow(link.b + dir * link.tip_offset, dir);
-        }
         candidates(view, index, &region)
     } else {
         (heapless::Vec::new(), false)
