@@ -1,0 +1,273 @@
+//! The simulated board: the firmware's [`Board`] on one side of a pseudo-terminal pair this
+//! process creates, in a thread; a host connects to the other side's path (`/dev/pts/N`)
+//! exactly as it would to a UART.
+//!
+//! For robustness tests the line can be noisy ([`Corruption`]) and the board can be
+//! power-cycled once mid-run ([`SimOptions::restart_after`]): the [`Board`] is dropped and a
+//! new one boots on the same PTY, losing whatever it had received of the frame in flight.
+
+mod corrupt;
+mod line;
+
+use std::cell::RefCell;
+use std::fmt;
+use std::io;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use digiteyes_core::protocol::Stats;
+use digiteyes_firmware::{Board, NoLed, Uploads};
+use serialport::{SerialPort, TTYPort};
+
+pub use corrupt::{Corruption, Window};
+
+use crate::clock::MonotonicClock;
+use crate::serial::TtySerial;
+use line::{Line, SimPort};
+
+/// The board name the simulator reports in `Hello`.
+pub const SIM_BOARD_NAME: &str = "linux-sim";
+
+/// How long an idle board waits for input before looking at its other work again.
+const IDLE_WAIT: Duration = Duration::from_millis(5);
+
+/// A board write nobody reads for this long is dropped, like a UART's bytes when no host is
+/// listening (a PTY would block the board instead).
+const UNREAD_WRITE_LIMIT: Duration = Duration::from_secs(1);
+
+/// How the simulated board is set up.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct SimOptions {
+    /// Bytes of the board's frame buffer: the largest frame it accepts (default VGA,
+    /// 640 × 480).
+    pub frame_buffer_bytes: usize,
+    /// Line noise, if any.
+    pub corruption: Option<Corruption>,
+    /// Power-cycle the board once, right after it has received the first chunk of the frame
+    /// that follows this many uploaded frames.
+    pub restart_after: Option<u32>,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        SimOptions {
+            frame_buffer_bytes: 640 * 480,
+            corruption: None,
+            restart_after: None,
+        }
+    }
+}
+
+impl SimOptions {
+    /// With line noise.
+    pub fn corruption(mut self, corruption: Corruption) -> Self {
+        self.corruption = Some(corruption);
+        self
+    }
+
+    /// With one power cycle after `frames` uploaded frames.
+    pub fn restart_after(mut self, frames: u32) -> Self {
+        self.restart_after = Some(frames);
+        self
+    }
+
+    /// With a frame buffer of `bytes`.
+    pub fn frame_buffer_bytes(mut self, bytes: usize) -> Self {
+        self.frame_buffer_bytes = bytes;
+        self
+    }
+}
+
+/// What the simulated board and its line did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SimReport {
+    /// Power cycles.
+    pub restarts: u32,
+    /// Bytes received from the host.
+    pub bytes_in: u64,
+    /// Bytes sent to the host.
+    pub bytes_out: u64,
+    /// Received bytes the line noise hit.
+    pub corrupted_in: u64,
+    /// Sent bytes the line noise hit.
+    pub corrupted_out: u64,
+    /// Sent bytes dropped because no host read them.
+    pub discarded_out: u64,
+    /// Serial errors the board loop returned (the loop goes on after each).
+    pub serial_errors: u64,
+    /// The current board's counters (since its last boot).
+    pub board: Stats,
+}
+
+impl fmt::Display for SimReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "board line: {} bytes in ({} corrupted), {} bytes out ({} corrupted, {} unread), \
+             {} restart(s), {} serial error(s)",
+            self.bytes_in,
+            self.corrupted_in,
+            self.bytes_out,
+            self.corrupted_out,
+            self.discarded_out,
+            self.restarts,
+            self.serial_errors
+        )
+    }
+}
+
+/// A running simulated board. Stops (and joins its thread) when dropped.
+#[derive(Debug)]
+pub struct SimBoard {
+    path: PathBuf,
+    stop: Arc<AtomicBool>,
+    report: Arc<Mutex<SimReport>>,
+    thread: Option<JoinHandle<io::Result<()>>>,
+    /// The PTY's slave side, held open so the board's side never sees a hang-up between
+    /// hosts.
+    _slave: TTYPort,
+}
+
+impl SimBoard {
+    /// Creates a PTY pair and boots the board on its master side; connect to [`SimBoard::path`].
+    pub fn start(options: SimOptions) -> io::Result<SimBoard> {
+        let (master, slave) = TTYPort::pair().map_err(io::Error::from)?;
+        let path = slave
+            .name()
+            .map(PathBuf::from)
+            .ok_or_else(|| io::Error::other("the PTY has no device path"))?;
+        let mut tty = TtySerial::from_port(master);
+        tty.discard_unread_writes(Some(UNREAD_WRITE_LIMIT));
+        let stop = Arc::new(AtomicBool::new(false));
+        let report = Arc::new(Mutex::new(SimReport::default()));
+        let thread = std::thread::Builder::new()
+            .name("digiteyes-sim-board".into())
+            // The board value holds the tracker; give it room whatever the platform default.
+            .stack_size(16 << 20)
+            .spawn({
+                let (stop, report) = (stop.clone(), report.clone());
+                move || run(tty, options, &stop, &report)
+            })?;
+        Ok(SimBoard {
+            path,
+            stop,
+            report,
+            thread: Some(thread),
+            _slave: slave,
+        })
+    }
+
+    /// The device to connect to (e.g. `/dev/pts/3`).
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// What the board and its line have done so far.
+    pub fn report(&self) -> SimReport {
+        self.report.lock().map(|r| *r).unwrap_or_default()
+    }
+
+    /// Whether the board thread is still running (it stops only on [`SimBoard::stop`] or an
+    /// unrecoverable error).
+    pub fn is_running(&self) -> bool {
+        self.thread.as_ref().is_some_and(|t| !t.is_finished())
+    }
+
+    /// Stops the board and returns its report, or the error that stopped it.
+    pub fn stop(mut self) -> io::Result<SimReport> {
+        self.shut_down()?;
+        Ok(self.report())
+    }
+
+    /// Waits until the board thread ends (it runs until stopped: this is "until Ctrl-C").
+    pub fn wait(mut self) -> io::Result<SimReport> {
+        if let Some(thread) = self.thread.take() {
+            join(thread)?;
+        }
+        Ok(self.report())
+    }
+
+    fn shut_down(&mut self) -> io::Result<()> {
+        self.stop.store(true, Ordering::Relaxed);
+        match self.thread.take() {
+            Some(thread) => join(thread),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Drop for SimBoard {
+    fn drop(&mut self) {
+        let _ = self.shut_down();
+    }
+}
+
+fn join(thread: JoinHandle<io::Result<()>>) -> io::Result<()> {
+    thread
+        .join()
+        .map_err(|_| io::Error::other("the simulated board panicked"))?
+}
+
+/// The board thread: boot, poll until stopped, power-cycle when the line says so.
+fn run(
+    tty: TtySerial,
+    options: SimOptions,
+    stop: &AtomicBool,
+    report: &Arc<Mutex<SimReport>>,
+) -> io::Result<()> {
+    let line = Rc::new(RefCell::new(Line::new(
+        tty,
+        options.corruption.clone(),
+        options.restart_after,
+        report.clone(),
+    )));
+    let mut frame_buffer = vec![0u8; options.frame_buffer_bytes];
+    let note = |f: &dyn Fn(&mut SimReport)| {
+        if let Ok(mut r) = report.lock() {
+            f(&mut r);
+        }
+    };
+    loop {
+        let mut board = Board::new(
+            SIM_BOARD_NAME,
+            &mut frame_buffer,
+            None,
+            SimPort(line.clone()),
+            Uploads,
+            NoLed,
+            MonotonicClock::new(),
+        );
+        if board.start().is_err() {
+            note(&|r| r.serial_errors += 1);
+        }
+        loop {
+            if stop.load(Ordering::Relaxed) {
+                let stats = board.stats();
+                note(&|r| r.board = stats);
+                return Ok(());
+            }
+            if line.borrow().restart_due() {
+                break;
+            }
+            let busy = match board.poll() {
+                Ok(busy) => busy,
+                Err(_) => {
+                    note(&|r| r.serial_errors += 1);
+                    false
+                }
+            };
+            let stats = board.stats();
+            note(&|r| r.board = stats);
+            if !busy {
+                line.borrow_mut().wait_input(IDLE_WAIT)?;
+            }
+        }
+        drop(board);
+        line.borrow_mut().power_cycled();
+    }
+}
