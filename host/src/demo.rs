@@ -1,12 +1,21 @@
-//! The demo: render the `mouse` scenario, track it, evaluate it.
+//! The demo: render the `mouse` scenario, stream it to a simulated Linux board over a real
+//! pseudo-terminal serial link, and evaluate the states the board sent back.
+//!
+//! ```text
+//! renderer ─▶ camN/*.pgm ─▶ host (stream) ═══ PTY ═══ board (firmware loop, tracker)
+//!                               ▲                          │
+//!                               └──── State per frame ◀────┘ ─▶ states.csv ─▶ eval
+//! ```
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
+use digiteyes_board_linux::{SimOptions, SimReport};
+use digiteyes_core::protocol::TrackerParams;
 
 use crate::eval::{evaluate, EvalReport};
 use crate::scenarios::{render_scenario, RenderOptions};
-use crate::track::{track_sequence, TrackSummary};
+use crate::stream::{stream_sequence, StreamOptions, StreamSummary};
 use crate::TrackerConfig;
 
 /// The scenario the demo runs.
@@ -17,15 +26,17 @@ pub const DEMO_SCENARIO: &str = "mouse";
 pub struct DemoResult {
     /// The rendered sequence's folder (gone after return unless kept).
     pub sequence: PathBuf,
-    /// The tracking run.
-    pub track: TrackSummary,
-    /// The evaluation.
+    /// The stream to the simulated board (its link figures included).
+    pub stream: StreamSummary,
+    /// The simulated board's side of the line.
+    pub board: SimReport,
+    /// The evaluation of the board's states.
     pub eval: EvalReport,
 }
 
 /// Renders `frames` frames of the `mouse` scenario into `keep` (or a temporary folder that is
-/// removed afterwards), tracks them with `config` and evaluates the result. The states go to
-/// `states.csv` in the sequence folder.
+/// removed afterwards), streams them to a simulated board running `config`, and evaluates the
+/// states it sent back (written to `states.csv` in the sequence folder).
 pub fn run_demo(
     frames: usize,
     keep: Option<&Path>,
@@ -46,12 +57,18 @@ pub fn run_demo(
         ..RenderOptions::default()
     };
     render_scenario(DEMO_SCENARIO, &dir, &opts)?;
+    let board = crate::sim::start(SimOptions::default())?;
+    let port = board.path().display().to_string();
     let states = dir.join("states.csv");
-    let track = track_sequence(&dir, &states, config, progress)?;
+    let mut options = StreamOptions::new(port).progress(progress);
+    options.tracker = TrackerParams::from_config(&config);
+    let stream = stream_sequence(&dir, &states, &options)?;
+    let board = board.stop().context("the simulated board failed")?;
     let eval = evaluate(&dir, &states)?;
     Ok(DemoResult {
         sequence: dir,
-        track,
+        stream,
+        board,
         eval,
     })
 }

@@ -8,7 +8,12 @@
 //! - [`scenarios`]: named synthetic sequences (`mouse`, `rigid`, ...) written to disk.
 //! - [`track`]: runs the core tracker over a sequence and writes the estimated states.
 //! - [`eval`]: compares estimated states with the ground truth (px, deg, mm).
-//! - [`demo`]: render, track and evaluate the `mouse` scenario in one go.
+//! - [`link`]: the host's side of the board link: serial port, set-up, frame uploads, reports.
+//! - [`stream`]: frames to a board, states back as `track`'s CSV.
+//! - [`listen`]: a board's messages printed and forwarded as JSON lines over UDP.
+//! - [`sim`]: the simulated Linux board on a pseudo-terminal.
+//! - [`demo`]: render the `mouse` scenario, stream it to a simulated board over a PTY, and
+//!   evaluate what came back.
 //!
 //! Units everywhere: millimetres, radians (degrees only in reports), pixels (pixel (0, 0) is
 //! the centre of the top-left pixel).
@@ -17,15 +22,20 @@
 
 pub mod demo;
 pub mod eval;
+pub mod link;
+pub mod listen;
 pub mod progress;
 pub mod render;
 pub mod scenarios;
 pub mod sequence;
+pub mod sim;
+pub mod stream;
 pub mod track;
 
 pub use eval::{evaluate, CameraErrors, EvalReport};
 pub use render::RenderSettings;
 pub use scenarios::{render_scenario, RenderOptions};
+pub use stream::{stream_sequence, StreamOptions, StreamSummary};
 pub use track::{track_sequence, TrackSummary};
 
 /// Re-exported so callers can build a [`TrackerConfig`] without naming the core crate.

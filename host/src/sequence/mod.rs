@@ -53,8 +53,17 @@ impl Sequence {
     /// free list, and counts the frames of every camera (which must agree). Frame headers are
     /// not read here: see [`Sequence::check_frames`].
     pub fn open(dir: &Path) -> Result<Sequence> {
-        let json_path = dir.join(SEQUENCE_JSON);
-        let text = std::fs::read_to_string(&json_path)
+        let mut sequence = Self::open_description(&dir.join(SEQUENCE_JSON))?;
+        sequence.frames = count_all_frames(dir, sequence.cameras.len())?;
+        Ok(sequence)
+    }
+
+    /// Reads and checks a `sequence.json` (at any path) like [`Sequence::open`], without
+    /// looking for frames: `frames` is 0 and `dir` is the file's folder. For setting up a
+    /// live camera from a calibration in the sequence format.
+    pub fn open_description(json_path: &Path) -> Result<Sequence> {
+        let dir = json_path.parent().unwrap_or(Path::new("."));
+        let text = std::fs::read_to_string(json_path)
             .with_context(|| format!("cannot read {}", json_path.display()))?;
         let file = SequenceFile::from_json(&text)
             .with_context(|| format!("{}: invalid sequence description", json_path.display()))?;
@@ -69,7 +78,6 @@ impl Sequence {
             }
             None => None,
         };
-        let frames = count_all_frames(dir, cameras.len())?;
         Ok(Sequence {
             dir: dir.to_path_buf(),
             file,
@@ -77,7 +85,7 @@ impl Sequence {
             cameras,
             initial_state,
             free,
-            frames,
+            frames: 0,
         })
     }
 

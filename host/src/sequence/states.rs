@@ -149,22 +149,30 @@ pub struct StatesWriter {
     out: BufWriter<File>,
     path: PathBuf,
     n_states: usize,
+    extra_columns: usize,
     frames: usize,
 }
 
 impl StatesWriter {
     /// Creates `path` and writes the header.
     pub fn create(path: &Path, n_states: usize) -> Result<Self> {
+        Self::with_columns(path, n_states, &[])
+    }
+
+    /// Creates `path` and writes the header, with `extra` columns after [`REPORT_COLUMNS`]
+    /// (their values are given to [`StatesWriter::write_with`]).
+    pub fn with_columns(path: &Path, n_states: usize, extra: &[&str]) -> Result<Self> {
         let file =
             File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
         let mut writer = StatesWriter {
             out: BufWriter::new(file),
             path: path.to_path_buf(),
             n_states,
+            extra_columns: extra.len(),
             frames: 0,
         };
         let mut header = state_header(n_states);
-        for c in REPORT_COLUMNS {
+        for c in REPORT_COLUMNS.iter().chain(extra) {
             header.push(',');
             header.push_str(c);
         }
@@ -172,8 +180,19 @@ impl StatesWriter {
         Ok(writer)
     }
 
-    /// Appends the row of the next frame.
+    /// Appends the row of the next frame (extra columns, if any, left empty).
     pub fn write(&mut self, state: &[f32], report: &FrameReport) -> Result<()> {
+        self.write_with(state, report, &[])
+    }
+
+    /// Appends the row of the next frame with the values of the extra columns (missing ones
+    /// empty; the values must not contain commas).
+    pub fn write_with(
+        &mut self,
+        state: &[f32],
+        report: &FrameReport,
+        extra: &[&str],
+    ) -> Result<()> {
         if state.len() != self.n_states {
             bail!(
                 "{}: state has {} values, the header {}",
@@ -200,6 +219,17 @@ impl StatesWriter {
             report.features_expected,
             u8::from(report.lost)
         ));
+        for i in 0..self.extra_columns {
+            let value = extra.get(i).copied().unwrap_or("");
+            if value.contains([',', '\n']) {
+                bail!(
+                    "{}: column value `{value}` contains a comma or newline",
+                    self.path.display()
+                );
+            }
+            line.push(',');
+            line.push_str(value);
+        }
         self.line(&line)?;
         self.frames += 1;
         Ok(())

@@ -1,0 +1,361 @@
+//! A tracking session with a board: set it up, upload frames one at a time and collect each
+//! one's fate, follow the board through reboots, and read its counters at the end.
+//!
+//! ```text
+//! host                                   board
+//!  Configure ───────────────────────────▶  Ack(Configure)
+//!  Reset(q, free) ──────────────────────▶  Hello, Ack(Reset)      (Hello checked: version, model)
+//!  FrameChunk × ⌈w·h / MAX_CHUNK⌉ ───────▶  State | Dropped        (one answer per frame)
+//!  …                                      Hello (unsolicited: it rebooted → Configure, Reset
+//!                                                from the last state, go on)
+//!  Ping(t) ─────────────────────────────▶  Stats, Pong(t)
+//! ```
+
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Result};
+use digiteyes_core::config::MAX_STATES;
+use digiteyes_core::protocol::{
+    BoardMessage, Command, Configure, FrameChunk, Hello, HostMessage, Refusal, Reset, MAX_CHUNK,
+    PROTOCOL_VERSION,
+};
+use heapless::Vec as HVec;
+
+use super::outcome::{DropCause, FrameOutcome};
+use super::port::Link;
+use super::report::LinkReport;
+use super::setup::SessionSetup;
+
+/// Attempts at a command (`Configure`, `Reset`, `Ping`) before giving up: on a noisy line a
+/// command or its answer may be lost.
+const ATTEMPTS: u32 = 3;
+
+/// Frames in a row without a byte from the board (answer and probe timed out) after which the
+/// board counts as gone.
+const SILENT_FRAMES: u32 = 3;
+
+/// A set-up board, ready for frames.
+#[derive(Debug)]
+pub struct Session {
+    link: Link,
+    setup: SessionSetup,
+    hello: Hello,
+    /// The state to restart from after a reboot: the last tracked one.
+    last_state: Vec<f32>,
+    started: Instant,
+    report: LinkReport,
+    /// Pings sent to probe for lost answers (their tokens count up from 1; the final ping's
+    /// tokens are above them).
+    probes: u32,
+    /// Frames in a row with no byte at all from the board.
+    silent: u32,
+}
+
+impl Session {
+    /// Sets the board on `link` up for `setup`: `Configure`, then `Reset` (whose `Hello` is
+    /// checked: protocol version and model digest). Fails with what the board said.
+    pub fn start(link: Link, setup: SessionSetup) -> Result<Session> {
+        let mut session = Session {
+            link,
+            last_state: setup.initial_state.clone(),
+            setup,
+            hello: placeholder_hello(),
+            started: Instant::now(),
+            report: LinkReport::default(),
+            probes: 0,
+            silent: 0,
+        };
+        let q = session.last_state.clone();
+        session.hello = session.handshake(&q)?;
+        session.started = Instant::now();
+        Ok(session)
+    }
+
+    /// The board's `Hello` (the latest).
+    pub fn hello(&self) -> &Hello {
+        &self.hello
+    }
+
+    /// The link.
+    pub fn link(&self) -> &Link {
+        &self.link
+    }
+
+    /// Uploads frame `frame` (`width × height` bytes of packed 8-bit grey) and waits for its
+    /// answer. Any size is sent: the board refuses sizes other than its camera's
+    /// (`Dropped{WrongSize}`).
+    pub fn track(
+        &mut self,
+        frame: u32,
+        pixels: &[u8],
+        width: u16,
+        height: u16,
+    ) -> Result<FrameOutcome> {
+        let mut offset = 0usize;
+        for data in pixels.chunks(MAX_CHUNK) {
+            self.link.send(&HostMessage::FrameChunk(FrameChunk {
+                frame,
+                width,
+                height,
+                offset: offset as u32,
+                data,
+            }))?;
+            offset += data.len();
+        }
+        let outcome = self.await_answer(frame)?;
+        self.report.count(&outcome);
+        if let FrameOutcome::Tracked(state) = &outcome {
+            self.last_state = state.q.to_vec();
+        }
+        Ok(outcome)
+    }
+
+    /// Pings the board for its counters and returns the session's figures. The link stays
+    /// usable (see [`Session::into_link`]).
+    pub fn finish(&mut self) -> Result<LinkReport> {
+        self.report.seconds = self.started.elapsed().as_secs_f64();
+        for attempt in 1..=ATTEMPTS {
+            let token = self.probes + attempt;
+            self.link.send(&HostMessage::Ping(token))?;
+            let deadline = Instant::now() + self.setup.reply_timeout;
+            while let Some(message) = self.link.recv_until(deadline)? {
+                match message {
+                    BoardMessage::Pong(t) if t == token => {
+                        self.report.pong = true;
+                        return Ok(self.snapshot());
+                    }
+                    other => self.aside(other)?,
+                }
+            }
+        }
+        // The counters are a report, not the work: without them the report says so.
+        self.report.pong = false;
+        Ok(self.snapshot())
+    }
+
+    /// Ends the session, handing back the link (e.g. to listen on).
+    pub fn into_link(self) -> Link {
+        self.link
+    }
+
+    fn snapshot(&self) -> LinkReport {
+        let mut report = self.report.clone();
+        report.bytes_up = self.link.bytes_up();
+        report.bytes_down = self.link.bytes_down();
+        report.host_link = self.link.counters();
+        report.board_name = self.hello.board.to_string();
+        report
+    }
+
+    /// Waits for `frame`'s `State` or `Dropped`. Without one in time, probes with a `Ping`:
+    /// the board answers a ping after everything it received before, so a `Pong` without
+    /// the frame's answer means the frame is lost (e.g. its last chunk was), while a slow
+    /// answer still counts. A board that sends no byte at all through [`SILENT_FRAMES`]
+    /// frames in a row is gone: an error.
+    fn await_answer(&mut self, frame: u32) -> Result<FrameOutcome> {
+        let bytes_before = self.link.bytes_down();
+        if let Some(outcome) = self.answer_or(frame, None)? {
+            return Ok(outcome);
+        }
+        self.probes += 1;
+        let token = self.probes;
+        self.link.send(&HostMessage::Ping(token))?;
+        if let Some(outcome) = self.answer_or(frame, Some(token))? {
+            return Ok(outcome);
+        }
+        if self.link.bytes_down() == bytes_before {
+            self.silent += 1;
+            if self.silent >= SILENT_FRAMES {
+                bail!(
+                    "the board on {} has sent nothing for {} frames ({:.0} s): is it still \
+                     connected and running?",
+                    self.link.path(),
+                    self.silent,
+                    2.0 * f64::from(self.silent) * self.setup.reply_timeout.as_secs_f64()
+                );
+            }
+        } else {
+            self.silent = 0;
+        }
+        Ok(FrameOutcome::Dropped(DropCause::NoReply))
+    }
+
+    /// Waits up to the reply timeout for `frame`'s answer, or for `Pong(token)` (which means
+    /// there will be none); `None` when neither came.
+    fn answer_or(&mut self, frame: u32, token: Option<u32>) -> Result<Option<FrameOutcome>> {
+        let deadline = Instant::now() + self.setup.reply_timeout;
+        loop {
+            let Some(message) = self.link.recv_until(deadline)? else {
+                return Ok(None);
+            };
+            if let BoardMessage::Pong(t) = message {
+                if Some(t) == token {
+                    return Ok(Some(FrameOutcome::Dropped(DropCause::NoReply)));
+                }
+                continue;
+            }
+            let outcome = self.answer(frame, message)?;
+            if outcome.is_some() {
+                self.silent = 0;
+                return Ok(outcome);
+            }
+        }
+    }
+
+    /// `frame`'s outcome if `message` decides it; other messages are set aside.
+    fn answer(&mut self, frame: u32, message: BoardMessage) -> Result<Option<FrameOutcome>> {
+        Ok(Some(match message {
+            BoardMessage::State(state) if state.frame == frame => FrameOutcome::Tracked(state),
+            BoardMessage::Dropped(d) if d.frame == frame => {
+                FrameOutcome::Dropped(DropCause::Board(d.reason))
+            }
+            BoardMessage::Hello(hello) => {
+                // The board rebooted: it lost the frame in flight and its setup.
+                self.check_hello(&hello)?;
+                self.report.restarts += 1;
+                let q = self.last_state.clone();
+                self.hello = self.handshake(&q)?;
+                FrameOutcome::Dropped(DropCause::BoardRestarted)
+            }
+            other => {
+                self.aside(other)?;
+                return Ok(None);
+            }
+        }))
+    }
+
+    /// A message nobody is waiting for: counters, stale answers, features.
+    fn aside(&mut self, message: BoardMessage) -> Result<()> {
+        match message {
+            BoardMessage::Stats(stats) => self.report.board = Some(stats),
+            BoardMessage::State(_) | BoardMessage::Dropped(_) => self.report.late_answers += 1,
+            BoardMessage::Features(_) => self.report.features += 1,
+            BoardMessage::Hello(hello) => {
+                self.check_hello(&hello)?;
+                self.hello = hello;
+            }
+            BoardMessage::Ack(_) | BoardMessage::Nak(..) | BoardMessage::Pong(_) => {}
+        }
+        Ok(())
+    }
+
+    /// `Configure` then `Reset` from `q`, each until answered; returns the `Hello` that came
+    /// with the reset.
+    fn handshake(&mut self, q: &[f32]) -> Result<Hello> {
+        let configure = HostMessage::Configure(Configure {
+            camera: self.setup.camera,
+            tracker: self.setup.tracker,
+            features_every: self.setup.features_every,
+            stats_every: self.setup.stats_every,
+        });
+        self.command(&configure, Command::Configure)?;
+        let q: HVec<f32, MAX_STATES> = q.iter().copied().take(MAX_STATES).collect();
+        let reset = HostMessage::Reset(Reset {
+            q,
+            free: self.setup.free,
+        });
+        self.command(&reset, Command::Reset)?.ok_or_else(|| {
+            anyhow::anyhow!(
+                "board on {} acknowledged Reset without a Hello",
+                self.link.path()
+            )
+        })
+    }
+
+    /// Sends `message` until `Ack(command)` comes back (at most [`ATTEMPTS`] times); returns
+    /// the last `Hello` seen meanwhile.
+    fn command(&mut self, message: &HostMessage<'_>, command: Command) -> Result<Option<Hello>> {
+        let mut hello = None;
+        for _ in 0..ATTEMPTS {
+            self.link.send(message)?;
+            let deadline = Instant::now() + self.setup.reply_timeout;
+            while let Some(answer) = self.link.recv_until(deadline)? {
+                match answer {
+                    BoardMessage::Ack(c) if c == command => return Ok(hello),
+                    BoardMessage::Nak(c, refusal) if c == command => {
+                        bail!(
+                            "board on {} refused {command:?}: {}",
+                            self.link.path(),
+                            refusal_text(refusal)
+                        )
+                    }
+                    BoardMessage::Hello(h) => {
+                        self.check_hello(&h)?;
+                        hello = Some(h);
+                    }
+                    other => self.aside(other)?,
+                }
+            }
+        }
+        bail!(
+            "no answer to {command:?} from a board on {} within {} x {:.1} s: is a digiteyes \
+             board connected there (and at the same baud rate)?",
+            self.link.path(),
+            ATTEMPTS,
+            self.setup.reply_timeout.as_secs_f64()
+        )
+    }
+
+    /// Refuses a board of another protocol version or with another model.
+    fn check_hello(&self, hello: &Hello) -> Result<()> {
+        if hello.version != PROTOCOL_VERSION {
+            bail!(
+                "board {} on {} speaks protocol version {}, this host speaks version {}",
+                hello.board,
+                self.link.path(),
+                hello.version,
+                PROTOCOL_VERSION
+            );
+        }
+        if hello.model_digest != self.setup.model_digest {
+            bail!(
+                "board {} on {} tracks another model (digest {:#010x}) than the sequence's \
+                 `{}` (digest {:#010x}): the board's is built in; track this sequence with \
+                 `digiteyes track` instead",
+                hello.board,
+                self.link.path(),
+                hello.model_digest,
+                self.setup.model_name,
+                self.setup.model_digest
+            );
+        }
+        Ok(())
+    }
+}
+
+/// What a board's refusal means, for an error message.
+fn refusal_text(refusal: Refusal) -> &'static str {
+    match refusal {
+        Refusal::BadCamera => "the camera is unusable (size or focal length)",
+        Refusal::BadParameters => "a tracker parameter is out of range",
+        Refusal::FrameTooLarge => "the camera's frames do not fit the board's frame buffer",
+        Refusal::BadState => "the state has the wrong length for the model or is not finite",
+        Refusal::BadFreeMask => "a free state is not a state of the model",
+        Refusal::NotConfigured => "it has no camera yet (Reset before Configure)",
+    }
+}
+
+fn placeholder_hello() -> Hello {
+    Hello {
+        version: 0,
+        board: heapless::String::new(),
+        model_digest: 0,
+        clock_hz: 0,
+        capacities: digiteyes_core::protocol::Capacities {
+            states: 0,
+            max_states: 0,
+            max_frames: 0,
+            max_frame_bytes: 0,
+            max_chunk: 0,
+            max_message: 0,
+        },
+    }
+}
+
+/// The reply timeout as a [`Duration`] from seconds given on the command line.
+pub fn reply_timeout(seconds: f64) -> Result<Duration> {
+    if !(seconds.is_finite() && seconds > 0.0) {
+        bail!("--reply-timeout must be a positive number of seconds, not {seconds}");
+    }
+    Ok(Duration::from_secs_f64(seconds))
+}

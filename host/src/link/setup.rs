@@ -1,0 +1,84 @@
+//! What a host tells a board before frames: the camera, the tracker parameters, the initial
+//! state and the free states — taken from a sequence's `sequence.json`.
+
+use std::time::Duration;
+
+use anyhow::{anyhow, bail, Result};
+use digiteyes_core::protocol::{model_digest, CameraParams, TrackerParams};
+
+use crate::sequence::Sequence;
+
+/// How long the host waits for a board's answer by default.
+pub const DEFAULT_REPLY_TIMEOUT: Duration = Duration::from_secs(2);
+
+/// Everything a session needs to set a board up.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SessionSetup {
+    /// The board's camera (`Configure`); frames must be its size.
+    pub camera: CameraParams,
+    /// Tracker parameters (`Configure`).
+    pub tracker: TrackerParams,
+    /// `Features` every this many frames (0: never).
+    pub features_every: u16,
+    /// `Stats` every this many frames (0: only when pinged).
+    pub stats_every: u16,
+    /// The state at the first frame (`Reset`): quaternion, mm, rad.
+    pub initial_state: Vec<f32>,
+    /// Bit `i`: state `i` is estimated (`Reset`).
+    pub free: u32,
+    /// [`model_digest`] of the model the frames show; the board's must match.
+    pub model_digest: u32,
+    /// The model's name for messages (`sequence.json`'s `model`).
+    pub model_name: String,
+    /// How long to wait for each answer (an upload's `State`/`Dropped`, an `Ack`).
+    pub reply_timeout: Duration,
+}
+
+impl SessionSetup {
+    /// The setup for tracking camera `camera` of `sequence` (`None`: the only camera; a
+    /// sequence with several cameras needs one picked — a board tracks one camera).
+    pub fn from_sequence(sequence: &Sequence, camera: Option<usize>) -> Result<Self> {
+        let n_cameras = sequence.cameras.len();
+        let index = match camera {
+            Some(i) if i < n_cameras => i,
+            Some(i) => bail!(
+                "{}: camera index {i} out of range: the sequence has {n_cameras} camera(s) \
+                 (0..{})",
+                sequence.dir.display(),
+                n_cameras - 1
+            ),
+            None if n_cameras == 1 => 0,
+            None => bail!(
+                "{}: the sequence has {n_cameras} cameras; a board tracks one camera (as the \
+                 IC40 ran one board per camera): pick one with --camera-index 0..{}",
+                sequence.dir.display(),
+                n_cameras - 1
+            ),
+        };
+        let camera = CameraParams::from_camera(&sequence.cameras[index]).ok_or_else(|| {
+            anyhow!(
+                "{}: camera {index} is larger than 65535 px on a side",
+                sequence.dir.display()
+            )
+        })?;
+        let n = sequence.n_states();
+        if n > 32 {
+            bail!("the model has {n} states; the link carries at most 32");
+        }
+        let free = sequence
+            .free_states()
+            .iter()
+            .fold(0u32, |mask, &s| mask | (1 << s));
+        Ok(SessionSetup {
+            camera,
+            tracker: TrackerParams::default(),
+            features_every: 0,
+            stats_every: 0,
+            initial_state: sequence.initial_state.iter().map(|&v| v as f32).collect(),
+            free,
+            model_digest: model_digest(&sequence.model),
+            model_name: sequence.file.model.clone(),
+            reply_timeout: DEFAULT_REPLY_TIMEOUT,
+        })
+    }
+}

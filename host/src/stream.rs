@@ -1,0 +1,282 @@
+//! `digiteyes stream`: frames to a board over a serial link, its states back, written as the
+//! same CSV as `track`.
+//!
+//! Frames come from a sequence folder or a V4L2 camera on the host; each is uploaded as
+//! `FrameChunk`s and answered by the board with a `State` or a `Dropped` (see
+//! [`link::Session`](crate::link::Session)). Every frame gets a row, in order: a dropped frame
+//! repeats the last state with `lost` = 1, and the extra last column `dropped` says why
+//! (empty for tracked frames).
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use anyhow::{anyhow, ensure, Context, Result};
+use digiteyes_board_linux::camera::V4l2Camera;
+use digiteyes_core::protocol::{State, TrackerParams};
+use digiteyes_core::tracker::FrameReport;
+
+use crate::link::{
+    DropCause, FrameOutcome, Link, LinkReport, Session, SessionSetup, DEFAULT_REPLY_TIMEOUT,
+};
+use crate::sequence::{Sequence, StatesWriter};
+
+/// The column `stream` adds after `track`'s: why a frame was not tracked.
+pub const DROPPED_COLUMN: &str = "dropped";
+
+/// The default line speed (bits/s).
+pub const DEFAULT_BAUD: u32 = 115_200;
+
+/// How to reach the board and what to tell it.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct StreamOptions {
+    /// The serial device of the board.
+    pub port: String,
+    /// Line speed (bits/s, 8N1).
+    pub baud: u32,
+    /// How long to wait for each frame's answer.
+    pub reply_timeout: Duration,
+    /// The camera of a multi-camera sequence to track (a board tracks one).
+    pub camera_index: Option<usize>,
+    /// The tracker parameters sent in `Configure`.
+    pub tracker: TrackerParams,
+    /// Show a progress bar (when stderr is a terminal).
+    pub progress: bool,
+}
+
+impl StreamOptions {
+    /// Defaults for the board on `port`: 115200 baud, 2 s reply timeout, the default tracker.
+    pub fn new(port: impl Into<String>) -> Self {
+        StreamOptions {
+            port: port.into(),
+            baud: DEFAULT_BAUD,
+            reply_timeout: DEFAULT_REPLY_TIMEOUT,
+            camera_index: None,
+            tracker: TrackerParams::default(),
+            progress: false,
+        }
+    }
+
+    /// With this reply timeout.
+    pub fn reply_timeout(mut self, timeout: Duration) -> Self {
+        self.reply_timeout = timeout;
+        self
+    }
+
+    /// Tracking camera `index` of the sequence.
+    pub fn camera_index(mut self, index: Option<usize>) -> Self {
+        self.camera_index = index;
+        self
+    }
+
+    /// With this baud rate.
+    pub fn baud(mut self, baud: u32) -> Self {
+        self.baud = baud;
+        self
+    }
+
+    /// With a progress bar or not.
+    pub fn progress(mut self, progress: bool) -> Self {
+        self.progress = progress;
+        self
+    }
+}
+
+/// What a stream did.
+#[derive(Debug, Clone)]
+pub struct StreamSummary {
+    /// Frames uploaded (rows written).
+    pub frames: usize,
+    /// The fate of every frame, in order.
+    pub outcomes: Vec<FrameOutcome>,
+    /// Mean RMS residual over the tracked frames (px).
+    pub mean_rms_px: f64,
+    /// Where the states were written.
+    pub out: PathBuf,
+    /// The link's figures.
+    pub link: LinkReport,
+}
+
+impl StreamSummary {
+    /// Frames the board tracked.
+    pub fn tracked(&self) -> usize {
+        self.link.tracked
+    }
+
+    /// The dropped frames and why, in order.
+    pub fn dropped(&self) -> Vec<(usize, DropCause)> {
+        self.outcomes
+            .iter()
+            .enumerate()
+            .filter_map(|(k, o)| match o {
+                FrameOutcome::Dropped(cause) => Some((k, *cause)),
+                FrameOutcome::Tracked(_) => None,
+            })
+            .collect()
+    }
+}
+
+impl fmt::Display for StreamSummary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "streamed {} frames: {} tracked ({} lost), {} dropped, mean rms {:.3} px",
+            self.frames,
+            self.link.tracked,
+            self.link.lost,
+            self.link.dropped_total(),
+            self.mean_rms_px
+        )?;
+        let dropped = self.dropped();
+        if !dropped.is_empty() {
+            let list: Vec<String> = dropped
+                .iter()
+                .take(12)
+                .map(|(k, cause)| format!("{k} ({cause})"))
+                .collect();
+            let more = dropped.len().saturating_sub(12);
+            write!(f, "dropped frames: {}", list.join(", "))?;
+            if more > 0 {
+                write!(f, " and {more} more")?;
+            }
+            writeln!(f)?;
+        }
+        writeln!(f, "states written to {}", self.out.display())?;
+        write!(f, "{}", self.link)
+    }
+}
+
+/// Streams every frame of the sequence in `seq` to the board and writes its states to
+/// `out_csv`.
+pub fn stream_sequence(
+    seq: &Path,
+    out_csv: &Path,
+    options: &StreamOptions,
+) -> Result<StreamSummary> {
+    let sequence = Sequence::open(seq)?;
+    let camera = pick_camera(&sequence, options.camera_index)?;
+    sequence.check_frames()?;
+    let session = connect(&sequence, options)?;
+    let frames = (0..sequence.frames).map(|k| {
+        let image = sequence.read_frame(camera, k)?;
+        Ok((image.width(), image.height(), image.into_raw()))
+    });
+    run(
+        session,
+        &sequence,
+        frames,
+        sequence.frames,
+        out_csv,
+        options,
+    )
+}
+
+/// Streams `frames` frames captured from the V4L2 camera `device` (on this host) to the
+/// board, set up from the calibration, model, initial state and free states in `setup` (a
+/// `sequence.json`; no frames needed), and writes its states to `out_csv`.
+pub fn stream_camera(
+    device: &Path,
+    setup: &Path,
+    frames: usize,
+    out_csv: &Path,
+    options: &StreamOptions,
+) -> Result<StreamSummary> {
+    let sequence = Sequence::open_description(setup)?;
+    let index = pick_camera(&sequence, options.camera_index)?;
+    let calibrated = &sequence.cameras[index];
+    let size = (calibrated.width, calibrated.height);
+    let mut camera = V4l2Camera::open(device, Some(size))?;
+    let session = connect(&sequence, options)?;
+    let mut buffer = vec![0u8; size.0 as usize * size.1 as usize];
+    let captured = (0..frames).map(move |_| {
+        camera
+            .capture(&mut buffer, true)
+            .with_context(|| format!("camera {}", device.display()))?;
+        Ok((size.0, size.1, buffer.clone()))
+    });
+    run(session, &sequence, captured, frames, out_csv, options)
+}
+
+fn pick_camera(sequence: &Sequence, index: Option<usize>) -> Result<usize> {
+    // SessionSetup says what is wrong with the choice; the index itself is all we need here.
+    SessionSetup::from_sequence(sequence, index)?;
+    Ok(index.unwrap_or(0))
+}
+
+fn connect(sequence: &Sequence, options: &StreamOptions) -> Result<Session> {
+    let mut setup = SessionSetup::from_sequence(sequence, options.camera_index)?;
+    setup.tracker = options.tracker;
+    setup.reply_timeout = options.reply_timeout;
+    let link = Link::open(&options.port, options.baud)?;
+    Session::start(link, setup)
+}
+
+type Frame = (u32, u32, Vec<u8>);
+
+fn run(
+    mut session: Session,
+    sequence: &Sequence,
+    frames: impl Iterator<Item = Result<Frame>>,
+    expected: usize,
+    out_csv: &Path,
+    options: &StreamOptions,
+) -> Result<StreamSummary> {
+    let mut writer = StatesWriter::with_columns(out_csv, sequence.n_states(), &[DROPPED_COLUMN])?;
+    let bar = crate::progress::bar(expected, "stream", options.progress);
+    let mut last: Vec<f32> = sequence.initial_state.iter().map(|&v| v as f32).collect();
+    let mut outcomes = Vec::with_capacity(expected);
+    let mut rms_sum = 0.0;
+    for (k, frame) in frames.enumerate() {
+        let (width, height, pixels) = frame?;
+        let number = u32::try_from(k).map_err(|_| anyhow!("frame {k}: too many frames"))?;
+        let size = |v: u32| u16::try_from(v).map_err(|_| anyhow!("frame {k} is over 65535 px"));
+        let outcome = session.track(number, &pixels, size(width)?, size(height)?)?;
+        match &outcome {
+            FrameOutcome::Tracked(state) => {
+                ensure!(
+                    state.q.len() == last.len(),
+                    "board on {} sent {} states for frame {k}, the model has {}",
+                    options.port,
+                    state.q.len(),
+                    last.len()
+                );
+                last.copy_from_slice(&state.q);
+                rms_sum += f64::from(state.rms_px);
+                writer.write_with(&last, &report_of(state), &[""])?;
+            }
+            FrameOutcome::Dropped(cause) => {
+                let report = FrameReport {
+                    rms_px: f32::NAN,
+                    lost: true,
+                    ..FrameReport::default()
+                };
+                writer.write_with(&last, &report, &[&cause.to_string()])?;
+            }
+        }
+        outcomes.push(outcome);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let frames = writer.finish()?;
+    let link = session.finish()?;
+    Ok(StreamSummary {
+        frames,
+        mean_rms_px: rms_sum / link.tracked.max(1) as f64,
+        outcomes,
+        out: out_csv.to_path_buf(),
+        link,
+    })
+}
+
+/// The tracker's report as the board sent it.
+pub fn report_of(state: &State) -> FrameReport {
+    FrameReport {
+        rms_px: state.rms_px,
+        features_found: state.features_found,
+        features_expected: state.features_expected,
+        iterations: state.iterations,
+        lost: state.lost,
+        ..FrameReport::default()
+    }
+}
