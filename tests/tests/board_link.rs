@@ -1,0 +1,260 @@
+//! The host and the simulated Linux board over a real pseudo-terminal serial link: states
+//! equal to the in-process tracker's, a noisy window, a power cycle, a wrong-size frame, and
+//! a missing device. Every wait is on a message or a condition, with a timeout that fails.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use digiteyes_board_linux::{Corruption, SimBoard, SimOptions, SimReport, Window};
+use digiteyes_core::frame::FrameView;
+use digiteyes_core::protocol::DropReason;
+use digiteyes_core::tracker::Tracker;
+use digiteyes_host::link::{DropCause, FrameOutcome, Link, Session, SessionSetup};
+use digiteyes_host::sequence::Sequence;
+use digiteyes_host::{
+    render_scenario, stream_sequence, RenderOptions, StreamOptions, StreamSummary, TrackerConfig,
+};
+
+/// A short `mouse` sequence at 320×240 (quick to render, upload and track).
+fn mouse(dir: &Path, frames: usize) -> PathBuf {
+    let seq = dir.join("mouse");
+    let options = RenderOptions {
+        frames: Some(frames),
+        size: Some((320, 240)),
+        supersample: 2,
+        ..RenderOptions::default()
+    };
+    render_scenario("mouse", &seq, &options).unwrap();
+    seq
+}
+
+/// Streams `seq` to a simulated board set up with `options`.
+fn stream_to_sim(
+    seq: &Path,
+    options: SimOptions,
+    reply_timeout: Duration,
+) -> (StreamSummary, SimReport) {
+    let board = SimBoard::start(options).unwrap();
+    let out = seq.join("board-states.csv");
+    let stream =
+        StreamOptions::new(board.path().display().to_string()).reply_timeout(reply_timeout);
+    let summary = stream_sequence(seq, &out, &stream).unwrap();
+    let report = board.stop().unwrap();
+    (summary, report)
+}
+
+fn tracked(outcome: &FrameOutcome) -> bool {
+    matches!(outcome, FrameOutcome::Tracked(_))
+}
+
+#[test]
+fn states_over_the_link_equal_the_in_process_tracker() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = mouse(dir.path(), 12);
+    let (summary, _) = stream_to_sim(&seq, SimOptions::default(), Duration::from_secs(5));
+    assert_eq!(summary.outcomes.len(), 12);
+
+    // The in-process tracker, exactly as `digiteyes track` sets it up.
+    let sequence = Sequence::open(&seq).unwrap();
+    let initial: Vec<f32> = sequence.initial_state.iter().map(|&v| v as f32).collect();
+    let mut tracker = Tracker::new(
+        sequence.model.clone(),
+        &sequence.cameras,
+        &initial,
+        sequence.free.as_deref(),
+        TrackerConfig::default(),
+    )
+    .unwrap();
+    for (k, outcome) in summary.outcomes.iter().enumerate() {
+        let image = sequence.read_frame(0, k).unwrap();
+        let view = FrameView::packed(
+            image.as_raw(),
+            image.width() as usize,
+            image.height() as usize,
+        )
+        .unwrap();
+        let report = tracker.track(&[view]).unwrap();
+        let FrameOutcome::Tracked(state) = outcome else {
+            panic!("frame {k} not tracked on the board: {outcome:?}");
+        };
+        assert_eq!(state.frame, k as u32);
+        let bits = |q: &[f32]| q.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(
+            bits(&state.q),
+            bits(tracker.state()),
+            "frame {k}: board {:?} host {:?}",
+            state.q,
+            tracker.state()
+        );
+        assert_eq!(state.rms_px.to_bits(), report.rms_px.to_bits(), "frame {k}");
+        assert_eq!(
+            (
+                state.iterations,
+                state.features_found,
+                state.features_expected,
+                state.lost
+            ),
+            (
+                report.iterations,
+                report.features_found,
+                report.features_expected,
+                report.lost
+            ),
+            "frame {k}"
+        );
+    }
+    let link = &summary.link;
+    assert!(link.pong, "the final ping was answered");
+    assert_eq!(link.host_link.crc_errors + link.host_link.framing_errors, 0);
+    let board = link.board.unwrap();
+    assert_eq!(board.frames, 12);
+    assert_eq!(board.link.crc_errors + board.link.framing_errors, 0);
+}
+
+#[test]
+fn one_percent_noise_mid_stream_costs_only_the_noisy_frames() {
+    const FRAMES: usize = 16;
+    const NOISY: std::ops::Range<u32> = 6..9;
+    let dir = tempfile::tempdir().unwrap();
+    let seq = mouse(dir.path(), FRAMES);
+    let noise = Corruption {
+        rate: 0.01,
+        window: Window::Frames(NOISY),
+        seed: 3,
+    };
+    let (summary, line) = stream_to_sim(
+        &seq,
+        SimOptions::default().corruption(noise),
+        Duration::from_secs(1),
+    );
+    let link = &summary.link;
+    let board = link.board.expect("the board's counters after the noise");
+    println!("{summary}");
+    println!("{line}");
+    println!(
+        "corruption figures: {} frames, {} delivered, {} dropped {:?}; bytes hit: {} of {} \
+         host->board, {} of {} board->host; CRC errors: board {} (+{} framing), host {} (+{} \
+         framing)",
+        summary.frames,
+        link.tracked,
+        link.dropped_total(),
+        summary.dropped(),
+        line.corrupted_in,
+        line.bytes_in,
+        line.corrupted_out,
+        line.bytes_out,
+        board.link.crc_errors,
+        board.link.framing_errors,
+        link.host_link.crc_errors,
+        link.host_link.framing_errors
+    );
+
+    // Every frame is accounted for, in order.
+    assert_eq!(summary.outcomes.len(), FRAMES);
+    assert_eq!(link.tracked + link.dropped_total(), FRAMES);
+    for (k, outcome) in summary.outcomes.iter().enumerate() {
+        if !NOISY.contains(&(k as u32)) {
+            // Before the window, and from the first frame after it: resynchronised.
+            assert!(tracked(outcome), "frame {k} outside the noise: {outcome:?}");
+        }
+    }
+    assert!(
+        summary.outcomes[NOISY.start as usize..NOISY.end as usize]
+            .iter()
+            .any(|o| !tracked(o)),
+        "1% of the bytes of ~1 KB chunks should cost frames"
+    );
+    // The noise reached both directions and both receivers counted it.
+    assert!(line.corrupted_in > 0 && line.corrupted_out > 0, "{line}");
+    let board_errors = board.link.crc_errors + board.link.framing_errors + board.link.overflows;
+    assert!(board_errors > 0, "{board:?}");
+    // Plausible: no more damaged frames than bytes hit (one hit spoils at most one frame,
+    // though a hit delimiter may merge two frames into one bad one).
+    assert!(
+        u64::from(board_errors) <= line.corrupted_in,
+        "{board:?} {line}"
+    );
+    let host_errors =
+        link.host_link.crc_errors + link.host_link.framing_errors + link.host_link.overflows;
+    assert!(
+        u64::from(host_errors) <= line.corrupted_out,
+        "{link:?} {line}"
+    );
+}
+
+#[test]
+fn a_board_power_cycle_mid_sequence_is_followed() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = mouse(dir.path(), 10);
+    let (summary, line) = stream_to_sim(
+        &seq,
+        SimOptions::default().restart_after(5),
+        Duration::from_secs(5),
+    );
+    println!("{summary}");
+    assert_eq!(line.restarts, 1);
+    assert_eq!(summary.link.restarts, 1);
+    for (k, outcome) in summary.outcomes.iter().enumerate() {
+        if k == 5 {
+            // The frame in flight when the board rebooted.
+            assert_eq!(
+                outcome,
+                &FrameOutcome::Dropped(DropCause::BoardRestarted),
+                "frame 5"
+            );
+        } else {
+            assert!(tracked(outcome), "frame {k}: {outcome:?}");
+        }
+    }
+    // The rebooted board counted from its boot: the frames after the restart.
+    assert_eq!(summary.link.board.unwrap().frames, 4);
+}
+
+#[test]
+fn a_wrong_size_frame_is_refused_and_the_next_one_tracked() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = mouse(dir.path(), 2);
+    let sequence = Sequence::open(&seq).unwrap();
+    let board = SimBoard::start(SimOptions::default()).unwrap();
+    let link = Link::open(&board.path().display().to_string(), 115_200).unwrap();
+    let mut session =
+        Session::start(link, SessionSetup::from_sequence(&sequence, None).unwrap()).unwrap();
+    let frame = |k| sequence.read_frame(0, k).unwrap().into_raw();
+
+    assert!(tracked(&session.track(0, &frame(0), 320, 240).unwrap()));
+    let small = vec![0u8; 160 * 120];
+    assert_eq!(
+        session.track(1, &small, 160, 120).unwrap(),
+        FrameOutcome::Dropped(DropCause::Board(DropReason::WrongSize(160, 120)))
+    );
+    assert!(tracked(&session.track(2, &frame(1), 320, 240).unwrap()));
+    let report = session.finish().unwrap();
+    assert_eq!(report.board.unwrap().dropped.wrong_size, 1);
+}
+
+#[test]
+fn a_stereo_sequence_needs_a_camera_picked() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("stereo");
+    let options = RenderOptions {
+        frames: Some(1),
+        size: Some((160, 120)),
+        supersample: 1,
+        ..RenderOptions::default()
+    };
+    render_scenario("fullhand-stereo", &seq, &options).unwrap();
+    let sequence = Sequence::open(&seq).unwrap();
+    let err = SessionSetup::from_sequence(&sequence, None).unwrap_err();
+    assert!(format!("{err:#}").contains("--camera-index"), "{err:#}");
+    assert!(SessionSetup::from_sequence(&sequence, Some(1)).is_ok());
+    assert!(SessionSetup::from_sequence(&sequence, Some(2)).is_err());
+}
+
+#[test]
+fn a_missing_device_is_named() {
+    let err = Link::open("/nonexistent/ttyDIGITEYES", 115_200).unwrap_err();
+    assert!(
+        format!("{err:#}").contains("/nonexistent/ttyDIGITEYES"),
+        "{err:#}"
+    );
+}
