@@ -61,7 +61,7 @@ impl Default for FeatureConfig {
         FeatureConfig {
             slices_per_link: 5,
             window_px: 20,
-            refine_margin_px: 1.0,
+            refine_margin_px: 1.5,
             min_contrast: 4.0,
             span: [0.15, 0.85],
             min_link_px: 6.0,
