@@ -66,7 +66,7 @@ impl Session {
             silent: 0,
         };
         let q = session.last_state.clone();
-        session.hello = session.handshake(&q)?;
+        session.hello = session.handshake(&q, None)?;
         session.started = Instant::now();
         Ok(session)
     }
@@ -214,7 +214,7 @@ impl Session {
                 self.check_hello(&hello)?;
                 self.report.restarts += 1;
                 let q = self.last_state.clone();
-                self.hello = self.handshake(&q)?;
+                self.hello = self.handshake(&q, Some(hello))?;
                 FrameOutcome::Dropped(DropCause::BoardRestarted)
             }
             other => {
@@ -240,8 +240,10 @@ impl Session {
     }
 
     /// `Configure` then `Reset` from `q`, each until answered; returns the `Hello` that came
-    /// with the reset.
-    fn handshake(&mut self, q: &[f32]) -> Result<Hello> {
+    /// with the reset, or `known` (a `Hello` already received and checked) if that one was
+    /// lost on the line. Without either, the reset is repeated (it restarts from the same
+    /// state, so repeating is harmless).
+    fn handshake(&mut self, q: &[f32], known: Option<Hello>) -> Result<Hello> {
         let configure = HostMessage::Configure(Configure {
             camera: self.setup.camera,
             tracker: self.setup.tracker,
@@ -254,12 +256,15 @@ impl Session {
             q,
             free: self.setup.free,
         });
-        self.command(&reset, Command::Reset)?.ok_or_else(|| {
-            anyhow::anyhow!(
-                "board on {} acknowledged Reset without a Hello",
-                self.link.path()
-            )
-        })
+        for _ in 0..ATTEMPTS {
+            if let Some(hello) = self.command(&reset, Command::Reset)?.or(known.clone()) {
+                return Ok(hello);
+            }
+        }
+        bail!(
+            "board on {} acknowledged Reset {ATTEMPTS} times without a Hello",
+            self.link.path()
+        )
     }
 
     /// Sends `message` until `Ack(command)` comes back (at most [`ATTEMPTS`] times); returns
