@@ -244,8 +244,9 @@ struct PortArgs {
     /// Line speed in bits/s (8N1; ignored by pseudo-terminals).
     #[arg(long, value_name = "B", default_value_t = DEFAULT_BAUD)]
     baud: u32,
-    /// Seconds to wait for each answer of the board (a frame's State or Dropped, an Ack);
-    /// a frame without an answer counts as dropped, "no reply (timeout)".
+    /// Seconds to wait for each answer of the board (a frame's State or Dropped, an Ack).
+    /// Without a frame's answer by then, a Ping probes for as long again (a slow answer still
+    /// counts); then the frame counts as dropped, "no reply (timeout)".
     #[arg(long, value_name = "S", default_value_t = 2.0)]
     reply_timeout: f64,
 }
