@@ -350,5 +350,8 @@ fn the_largest_messages_nearly_fill_max_message() {
         })
         .max()
         .unwrap();
-    assert!(largest * 10 >= MAX_MESSAGE * 9, "{largest} of {MAX_MESSAGE}");
+    assert!(
+        largest * 10 >= MAX_MESSAGE * 9,
+        "{largest} of {MAX_MESSAGE}"
+    );
 }

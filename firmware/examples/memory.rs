@@ -51,6 +51,9 @@ fn main() {
     println!("  receive buffer (decoder): {decoder} B");
     println!("  transmit buffer: {MAX_MESSAGE} B");
     for (name, w, h) in [("QQVGA", 160, 120), ("QVGA", 320, 240), ("VGA", 640, 480)] {
-        println!("frame buffer {name} {w}x{h}: {} B (+ the same again for an overlay)", w * h);
+        println!(
+            "frame buffer {name} {w}x{h}: {} B (+ the same again for an overlay)",
+            w * h
+        );
     }
 }
