@@ -60,6 +60,7 @@ pub fn candidates(
 
 /// [`cover`] restricted to the links `among` (indices into `view.links`) and, if `palm`, the
 /// palm: the same answer as `cover` when they are [`candidates`] for a box holding `p`.
+#[inline(never)] // the visibility mask of Table 4.1's features stage: kept whole for profiles
 pub fn cover_among(
     view: &ProjectedModel,
     camera: &Camera,
