@@ -100,6 +100,18 @@ pub fn now_ticks() -> u64 {
     }
 }
 
+/// The tracker board's clock: its ticks time-stamp each `State` and measure `track_ticks`
+/// (exactly 40 instructions per tick under `-icount shift=0`).
+impl digiteyes_firmware::Clock for Clock {
+    fn ticks(&mut self) -> u64 {
+        now_ticks()
+    }
+
+    fn hz(&self) -> u32 {
+        TICK_HZ
+    }
+}
+
 #[exception]
 fn SysTick() {
     WRAPS.fetch_add(1, Ordering::Relaxed);

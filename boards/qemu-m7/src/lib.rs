@@ -8,6 +8,10 @@
 //!   (exactly 40 instructions per tick under `-icount shift=0`), and [`clock::Delay`], an
 //!   `embedded-hal` `DelayNs` on it.
 //! - [`led::Led`]: the two FPGAIO user LEDs as `embedded-hal` `OutputPin`s.
+//! - [`stack`]: the stack's high-water mark (the stack is painted at reset).
+//! - [`host`]: the command line QEMU passes through semihosting (the host's serial device).
+//!
+//! [`clock::Clock`] is also the `digiteyes_firmware::Clock` of the tracker board (`src/main.rs`).
 //!
 //! Human-readable logs go through semihosting (`cortex_m_semihosting::hprintln!`) to QEMU's
 //! stdout, never onto the UART. A panic prints its message the same way and exits QEMU with a
@@ -20,8 +24,10 @@
 use panic_semihosting as _;
 
 pub mod clock;
+pub mod host;
 pub mod led;
 mod mmio;
+pub mod stack;
 pub mod uart;
 
 use core::sync::atomic::{AtomicBool, Ordering};

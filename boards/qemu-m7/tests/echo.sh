@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Bring-up test of the emulated board's UART0: builds the echo firmware (release), boots it on
-# QEMU with UART0 on one end of a socat PTY pair, sends random bytes into the other end, reads
-# the echo back, compares, and reports the round-trip rate in bytes/s.
+# Bring-up test of the emulated board's UART0: builds the echo firmware (release, `--bin echo`),
+# boots it on QEMU with UART0 on one end of a socat PTY pair, sends random bytes into the other
+# end, reads the echo back, compares, and reports the round-trip rate in bytes/s.
 #
 #   boards/qemu-m7/tests/echo.sh [BYTES]        (default 102400, about one QVGA frame)
 #
@@ -38,8 +38,8 @@ cleanup() {
 trap cleanup EXIT
 trap 'exit 130' INT TERM
 
-(cd "$board" && cargo build --release --quiet --bin digiteyes-board-qemu-m7)
-elf=$board/target/thumbv7em-none-eabihf/release/digiteyes-board-qemu-m7
+(cd "$board" && cargo build --release --quiet --bin echo)
+elf=$board/target/thumbv7em-none-eabihf/release/echo
 
 # A PTY pair: QEMU's UART0 on "board", this script on "host"; socat copies between them.
 socat pty,raw,echo=0,link="$tmp/board" pty,raw,echo=0,link="$tmp/host" 2>"$tmp/socat.log" &
@@ -54,10 +54,10 @@ stty -F "$tmp/host" raw -echo
 DIGITEYES_SERIAL=$tmp/board "$board/run-qemu" "$elf" >"$tmp/qemu.log" 2>&1 &
 pids+=($!)
 for _ in $(seq 100); do
-  grep -qs "digiteyes qemu-m7:" "$tmp/qemu.log" && break
+  grep -qs "digiteyes qemu-m7 echo:" "$tmp/qemu.log" && break
   sleep 0.05
 done
-if ! grep -q "digiteyes qemu-m7:" "$tmp/qemu.log"; then
+if ! grep -q "digiteyes qemu-m7 echo:" "$tmp/qemu.log"; then
   echo "FAIL: no boot banner from the firmware"
   cat "$tmp/qemu.log"
   exit 1
