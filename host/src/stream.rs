@@ -5,7 +5,8 @@
 //! `FrameChunk`s and answered by the board with a `State` or a `Dropped` (see
 //! [`link::Session`](crate::link::Session)). Every frame gets a row, in order: a dropped frame
 //! repeats the last state with `lost` = 1, and the extra last column `dropped` says why
-//! (empty for tracked frames).
+//! (empty for tracked frames). The summary adds the board's own measure of its work
+//! ([`BoardWork`]: `State::track_ticks` in ticks of its clock, `Hello::clock_hz`).
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -96,6 +97,8 @@ pub struct StreamSummary {
     pub out: PathBuf,
     /// The link's figures.
     pub link: LinkReport,
+    /// Ticks per second of the board's clock (`Hello::clock_hz`), the unit of `track_ticks`.
+    pub board_clock_hz: u32,
 }
 
 impl StreamSummary {
@@ -114,6 +117,70 @@ impl StreamSummary {
                 FrameOutcome::Tracked(_) => None,
             })
             .collect()
+    }
+
+    /// The board's work on the tracked frames (`State::track_ticks`, `State::iterations`);
+    /// `None` when no frame was tracked.
+    pub fn board_work(&self) -> Option<BoardWork> {
+        let (mut frames, mut ticks, mut iterations) = (0u64, 0u64, 0u64);
+        for outcome in &self.outcomes {
+            if let FrameOutcome::Tracked(state) = outcome {
+                frames += 1;
+                ticks += u64::from(state.track_ticks);
+                iterations += u64::from(state.iterations);
+            }
+        }
+        (frames > 0).then_some(BoardWork {
+            frames,
+            ticks,
+            iterations,
+            clock_hz: self.board_clock_hz,
+        })
+    }
+}
+
+/// The tracking work a board reported over a stream, in ticks of its clock.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoardWork {
+    /// Frames tracked.
+    pub frames: u64,
+    /// Their `track_ticks`, summed.
+    pub ticks: u64,
+    /// Their Gauss–Newton iterations, summed.
+    pub iterations: u64,
+    /// Ticks per second of the board's clock.
+    pub clock_hz: u32,
+}
+
+impl BoardWork {
+    /// Mean ticks per tracked frame.
+    pub fn ticks_per_frame(&self) -> f64 {
+        self.ticks as f64 / self.frames.max(1) as f64
+    }
+
+    /// Ticks per iteration: all ticks over all iterations (0 when none ran).
+    pub fn ticks_per_iteration(&self) -> f64 {
+        if self.iterations == 0 {
+            return 0.0;
+        }
+        self.ticks as f64 / self.iterations as f64
+    }
+}
+
+impl fmt::Display for BoardWork {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let ms = |ticks: f64| 1000.0 * ticks / f64::from(self.clock_hz.max(1));
+        write!(
+            f,
+            "board work: mean {:.0} ticks/frame, {:.0} ticks/iteration at {} Hz ({:.3} ms/frame, \
+             {:.3} ms/iteration; {:.2} iterations/frame)",
+            self.ticks_per_frame(),
+            self.ticks_per_iteration(),
+            self.clock_hz,
+            ms(self.ticks_per_frame()),
+            ms(self.ticks_per_iteration()),
+            self.iterations as f64 / self.frames.max(1) as f64
+        )
     }
 }
 
@@ -143,6 +210,9 @@ impl fmt::Display for StreamSummary {
             writeln!(f)?;
         }
         writeln!(f, "states written to {}", self.out.display())?;
+        if let Some(work) = self.board_work() {
+            writeln!(f, "{work}")?;
+        }
         write!(f, "{}", self.link)
     }
 }
@@ -260,12 +330,14 @@ fn run(
     bar.finish_and_clear();
     let frames = writer.finish()?;
     let link = session.finish()?;
+    let board_clock_hz = session.hello().clock_hz;
     Ok(StreamSummary {
         frames,
         mean_rms_px: rms_sum / link.tracked.max(1) as f64,
         outcomes,
         out: out_csv.to_path_buf(),
         link,
+        board_clock_hz,
     })
 }
 
@@ -278,5 +350,57 @@ pub fn report_of(state: &State) -> FrameReport {
         iterations: state.iterations,
         lost: state.lost,
         ..FrameReport::default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use digiteyes_core::protocol::DropReason;
+
+    fn tracked(track_ticks: u32, iterations: u8) -> FrameOutcome {
+        FrameOutcome::Tracked(State {
+            frame: 0,
+            timestamp: 0,
+            q: heapless::Vec::new(),
+            rms_px: 0.5,
+            lost: false,
+            features_found: 10,
+            features_expected: 10,
+            iterations,
+            track_ticks,
+        })
+    }
+
+    #[test]
+    fn board_work_sums_the_tracked_frames_only() {
+        let summary = StreamSummary {
+            frames: 3,
+            outcomes: vec![
+                tracked(100_000, 8),
+                FrameOutcome::Dropped(DropCause::Board(DropReason::Incomplete)),
+                tracked(50_000, 4),
+            ],
+            mean_rms_px: 0.5,
+            out: PathBuf::from("states.csv"),
+            link: LinkReport::default(),
+            board_clock_hz: 25_000_000,
+        };
+        let work = summary.board_work().unwrap();
+        assert_eq!((work.frames, work.ticks, work.iterations), (2, 150_000, 12));
+        assert_eq!(work.ticks_per_frame(), 75_000.0);
+        assert_eq!(work.ticks_per_iteration(), 12_500.0);
+        let text = summary.to_string();
+        assert!(
+            text.contains(
+                "board work: mean 75000 ticks/frame, 12500 ticks/iteration at 25000000 Hz"
+            ),
+            "{text}"
+        );
+        let none = StreamSummary {
+            outcomes: vec![FrameOutcome::Dropped(DropCause::NoReply)],
+            ..summary
+        };
+        assert!(none.board_work().is_none() && !none.to_string().contains("board work"));
     }
 }
