@@ -1,5 +1,5 @@
 //! The memory a Linux board takes besides its frame buffer (bytes, this target):
-//! `cargo run -p digiteyes-board-linux --example memory`. Figures are in docs/boards/linux.md.
+//! `cargo run -p digiteyes-board-linux --example linux_memory`. Figures are in docs/boards/linux.md.
 
 use std::mem::size_of;
 
