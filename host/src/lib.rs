@@ -36,7 +36,7 @@ pub use eval::{evaluate, CameraErrors, EvalReport};
 pub use render::RenderSettings;
 pub use scenarios::{render_scenario, RenderOptions};
 pub use stream::{stream_sequence, StreamOptions, StreamSummary};
-pub use track::{track_sequence, TrackSummary};
+pub use track::{sequence_tracker, track_sequence, TrackSummary};
 
 /// Re-exported so callers can build a [`TrackerConfig`] without naming the core crate.
 pub use digiteyes_core::tracker::TrackerConfig;

@@ -1,5 +1,6 @@
 //! `digiteyes`: render, track and evaluate hand sequences. A thin layer over the library.
 
+use digiteyes_board_linux::parse_frame_size;
 use std::io::IsTerminal;
 use std::ops::Range;
 use std::path::PathBuf;
@@ -69,7 +70,7 @@ enum Command {
         #[arg(long)]
         clutter: bool,
         /// Image size in px, e.g. 320x240 (default 640x480); the view stays the same.
-        #[arg(long, value_name = "WxH", value_parser = parse_size)]
+        #[arg(long, value_name = "WxH", value_parser = parse_frame_size)]
         size: Option<(u32, u32)>,
         /// Rays per pixel along each axis (3 = 9 rays per pixel).
         #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=8))]
@@ -137,7 +138,7 @@ enum Command {
         #[arg(long, value_name = "N")]
         restart_after: Option<u32>,
         /// The board's frame buffer: the largest frame it accepts, WxH px.
-        #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "640x480")]
+        #[arg(long, value_name = "WxH", value_parser = parse_frame_size, default_value = "640x480")]
         max_frame: (u32, u32),
         /// Print the line's byte and error counts every this many seconds (0: never).
         #[arg(long, value_name = "S", default_value_t = 0.0)]
@@ -249,20 +250,6 @@ struct PortArgs {
     /// counts); then the frame counts as dropped, "no reply (timeout)".
     #[arg(long, value_name = "S", default_value_t = 2.0)]
     reply_timeout: f64,
-}
-
-fn parse_size(text: &str) -> Result<(u32, u32), String> {
-    let (w, h) = text
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("`{text}` is not WxH, e.g. 320x240"))?;
-    let parse = |s: &str| {
-        s.trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|&v| v > 0)
-            .ok_or_else(|| format!("`{s}` is not a positive number of pixels"))
-    };
-    Ok((parse(w)?, parse(h)?))
 }
 
 fn main() -> ExitCode {

@@ -69,6 +69,22 @@ impl fmt::Display for TrackSummary {
     }
 }
 
+/// A tracker for `sequence`: its model, cameras, initial state and free states — how `track`
+/// starts, and the in-process reference the board tests compare against.
+pub fn sequence_tracker(
+    sequence: &Sequence,
+    config: TrackerConfig,
+) -> Result<Tracker, digiteyes_core::tracker::TrackerError> {
+    let initial: Vec<f32> = sequence.initial_state.iter().map(|&v| v as f32).collect();
+    Tracker::new(
+        sequence.model.clone(),
+        &sequence.cameras,
+        &initial,
+        sequence.free.as_deref(),
+        config,
+    )
+}
+
 /// Tracks every frame of the sequence in folder `seq` and writes the states to `out_csv`.
 /// A progress bar goes to stderr when `progress` is set and stderr is a terminal. Fails,
 /// naming the file, on unreadable input; fails naming the frame and its files if the tracker
@@ -82,15 +98,8 @@ pub fn track_sequence(
     let start = Instant::now();
     let sequence = Sequence::open(seq)?;
     sequence.check_frames()?;
-    let initial: Vec<f32> = sequence.initial_state.iter().map(|&v| v as f32).collect();
-    let mut tracker = Tracker::new(
-        sequence.model.clone(),
-        &sequence.cameras,
-        &initial,
-        sequence.free.as_deref(),
-        config,
-    )
-    .map_err(|e| anyhow!("{}: cannot start the tracker: {e}", seq.display()))?;
+    let mut tracker = sequence_tracker(&sequence, config)
+        .map_err(|e| anyhow!("{}: cannot start the tracker: {e}", seq.display()))?;
     let mut writer = StatesWriter::create(out_csv, sequence.n_states())?;
     let bar = crate::progress::bar(sequence.frames, "track", progress);
     let mut tracking = Duration::ZERO;

@@ -8,11 +8,11 @@ use std::time::Duration;
 use digiteyes_board_linux::{Corruption, SimBoard, SimOptions, SimReport, Window};
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::protocol::DropReason;
-use digiteyes_core::tracker::Tracker;
 use digiteyes_host::link::{DropCause, FrameOutcome, Link, Session, SessionSetup};
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::{
-    render_scenario, stream_sequence, RenderOptions, StreamOptions, StreamSummary, TrackerConfig,
+    render_scenario, sequence_tracker, stream_sequence, RenderOptions, StreamOptions,
+    StreamSummary, TrackerConfig,
 };
 
 /// A short `mouse` sequence at 320×240 (quick to render, upload and track).
@@ -56,15 +56,7 @@ fn states_over_the_link_equal_the_in_process_tracker() {
 
     // The in-process tracker, exactly as `digiteyes track` sets it up.
     let sequence = Sequence::open(&seq).unwrap();
-    let initial: Vec<f32> = sequence.initial_state.iter().map(|&v| v as f32).collect();
-    let mut tracker = Tracker::new(
-        sequence.model.clone(),
-        &sequence.cameras,
-        &initial,
-        sequence.free.as_deref(),
-        TrackerConfig::default(),
-    )
-    .unwrap();
+    let mut tracker = sequence_tracker(&sequence, TrackerConfig::default()).unwrap();
     for (k, outcome) in summary.outcomes.iter().enumerate() {
         let image = sequence.read_frame(0, k).unwrap();
         let view = FrameView::packed(

@@ -17,12 +17,11 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use digiteyes_core::frame::FrameView;
-use digiteyes_core::tracker::Tracker;
 use digiteyes_host::link::FrameOutcome;
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::{
-    evaluate, render_scenario, stream_sequence, track_sequence, RenderOptions, StreamOptions,
-    TrackerConfig,
+    evaluate, render_scenario, sequence_tracker, stream_sequence, track_sequence, RenderOptions,
+    StreamOptions, TrackerConfig,
 };
 
 /// Frames streamed: enough for the tracker to move, few enough for the slow UART.
@@ -241,15 +240,7 @@ fn the_emulated_m7_board_tracks_a_mouse_sequence_as_well_as_the_host() {
 
     // Report (not required): are the board's states the host's, bit for bit?
     let sequence = Sequence::open(&seq).unwrap();
-    let initial: Vec<f32> = sequence.initial_state.iter().map(|&v| v as f32).collect();
-    let mut tracker = Tracker::new(
-        sequence.model.clone(),
-        &sequence.cameras,
-        &initial,
-        sequence.free.as_deref(),
-        TrackerConfig::default(),
-    )
-    .unwrap();
+    let mut tracker = sequence_tracker(&sequence, TrackerConfig::default()).unwrap();
     let mut equal = 0;
     for (k, outcome) in summary.outcomes.iter().enumerate() {
         let image = sequence.read_frame(0, k).unwrap();

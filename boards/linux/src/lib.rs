@@ -20,12 +20,14 @@
 
 pub mod camera;
 pub mod clock;
+mod frame_size;
 pub mod led;
 pub mod serial;
 pub mod sim;
 pub mod source;
 
 pub use clock::MonotonicClock;
+pub use frame_size::parse_frame_size;
 pub use led::StatusLed;
 pub use serial::TtySerial;
 pub use sim::{Corruption, SimBoard, SimOptions, SimReport, Window};

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::Parser;
 use digiteyes_board_linux::{
-    camera::V4l2Camera, MonotonicClock, Source, StatusLed, TtySerial, BOARD_NAME,
+    camera::V4l2Camera, parse_frame_size, MonotonicClock, Source, StatusLed, TtySerial, BOARD_NAME,
 };
 use digiteyes_firmware::{Board, NoLed, Uploads};
 use linux_embedded_hal::Delay;
@@ -35,7 +35,7 @@ struct Args {
     /// Frame size in px, e.g. 320x240: the camera's capture size, and the largest frame the
     /// board accepts (its frame buffer). Default: the camera's current size, or 640x480
     /// without a camera.
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    #[arg(long, value_name = "WxH", value_parser = parse_frame_size)]
     size: Option<(u32, u32)>,
     /// GPIO chip of a status LED (lit while the board is tracking), e.g. /dev/gpiochip0.
     #[arg(long, value_name = "/dev/gpiochipN", requires = "led_line")]
@@ -46,20 +46,6 @@ struct Args {
     /// Sleep this long (µs) when there is nothing to do.
     #[arg(long, default_value_t = 200, value_name = "US")]
     idle_us: u32,
-}
-
-fn parse_size(text: &str) -> Result<(u32, u32), String> {
-    let (w, h) = text
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("`{text}` is not WxH, e.g. 320x240"))?;
-    let parse = |s: &str| {
-        s.trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|&v| (1..=u32::from(u16::MAX)).contains(&v))
-            .ok_or_else(|| format!("`{s}` is not a number of pixels (1-65535)"))
-    };
-    Ok((parse(w)?, parse(h)?))
 }
 
 fn main() -> ExitCode {
