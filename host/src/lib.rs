@@ -12,6 +12,7 @@
 //! - [`stream`]: frames to a board, states back as `track`'s CSV.
 //! - [`listen`]: a board's messages printed and forwarded as JSON lines over UDP.
 //! - [`sim`]: the simulated Linux board on a pseudo-terminal.
+//! - [`state_names`]: what each state means, for labels.
 //! - [`demo`]: render the `mouse` scenario, stream it to a simulated board over a PTY, and
 //!   evaluate what came back.
 //!
@@ -29,6 +30,7 @@ pub mod render;
 pub mod scenarios;
 pub mod sequence;
 pub mod sim;
+pub mod state_names;
 pub mod stream;
 pub mod track;
 
