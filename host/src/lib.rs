@@ -12,6 +12,7 @@
 //! - [`stream`]: frames to a board, states back as `track`'s CSV.
 //! - [`listen`]: a board's messages printed and forwarded as JSON lines over UDP.
 //! - [`sim`]: the simulated Linux board on a pseudo-terminal.
+//! - [`overlay`]: the debug overlay (model, slices, edges, tips over a frame) as RGB images.
 //! - [`state_names`]: what each state means, for labels.
 //! - [`demo`]: render the `mouse` scenario, stream it to a simulated board over a PTY, and
 //!   evaluate what came back.
@@ -25,6 +26,7 @@ pub mod demo;
 pub mod eval;
 pub mod link;
 pub mod listen;
+pub mod overlay;
 pub mod progress;
 pub mod render;
 pub mod scenarios;
