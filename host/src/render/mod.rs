@@ -12,6 +12,7 @@ pub mod background;
 pub mod filter;
 pub mod intersect;
 pub mod scene;
+pub mod shapes;
 
 use std::sync::Mutex;
 
@@ -23,6 +24,7 @@ use nalgebra::Vector3;
 
 pub use background::{Background, PLAIN_GREY};
 pub use scene::Scene;
+pub use shapes::{world_shapes, WorldShape};
 
 /// The hand's albedo: its grey level (0–255) when lit face-on.
 pub const ALBEDO: f64 = 200.0;

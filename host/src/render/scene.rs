@@ -5,12 +5,13 @@
 //! by its size and centre in its frame. Poses come from the core's kinematics and points go
 //! through the core's camera, so the renderer and the tracker share one geometry.
 
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use digiteyes_core::camera::Camera;
-use digiteyes_core::kinematics::Poses;
-use digiteyes_core::model::{Model, Shape};
+use digiteyes_core::model::Model;
 use digiteyes_core::nalgebra::Vector3 as V3f;
 use nalgebra::Vector3;
+
+use super::shapes::{world_shapes, WorldShape};
 
 use super::intersect::{ray_box, ray_capsule, Capsule, Hit, OrientedBox};
 
@@ -55,70 +56,33 @@ pub struct Scene {
 impl Scene {
     /// Places the shapes of `model` at states `q` (quaternion, mm, rad) in `camera`'s view.
     pub fn build(model: &Model, camera: &Camera, q: &[f32]) -> Result<Scene> {
-        let poses = Poses::compute(model, q).map_err(|e| anyhow!("state: {e}"))?;
         let to_cam = |p: &V3f<f32>| {
             let c = camera.to_camera(p);
             Vector3::new(f64::from(c.x), f64::from(c.y), f64::from(c.z))
         };
         let mut placed = Vec::new();
-        for (i, link) in model.links().iter().enumerate() {
-            let Some(pose) = poses.frame(i) else { continue };
-            match link.shape {
-                Shape::Cylinder { radius } => {
-                    let Some(&child) = link.children.first() else {
-                        continue;
-                    };
-                    let Some(end) = poses.origin(usize::from(child)) else {
-                        continue;
-                    };
-                    let r = f64::from(radius);
-                    let corners = sphere_box_corners(&pose.t, radius)
-                        .into_iter()
-                        .chain(sphere_box_corners(&end, radius));
-                    if let Some(rect) = project_rect(camera, corners) {
-                        placed.push(Placed {
-                            primitive: Primitive::Capsule(Capsule {
-                                a: to_cam(&pose.t),
-                                b: to_cam(&end),
-                                r,
-                            }),
-                            rect,
-                        });
-                    }
-                }
-                Shape::Box { size, centre } => {
-                    let centre_w = pose.apply(&V3f::new(centre[0], centre[1], centre[2]));
-                    let axes_w = [0, 1, 2].map(|k| pose.r.column(k).into_owned());
-                    let mut corners = Vec::with_capacity(8);
-                    for sx in [-0.5f32, 0.5] {
-                        for sy in [-0.5f32, 0.5] {
-                            for sz in [-0.5f32, 0.5] {
-                                corners.push(
-                                    centre_w
-                                        + axes_w[0] * (sx * size[0])
-                                        + axes_w[1] * (sy * size[1])
-                                        + axes_w[2] * (sz * size[2]),
-                                );
-                            }
-                        }
-                    }
-                    if let Some(rect) = project_rect(camera, corners) {
-                        let axes = axes_w.map(|a| {
-                            let c = camera.r * a;
-                            Vector3::new(f64::from(c.x), f64::from(c.y), f64::from(c.z)).normalize()
-                        });
-                        placed.push(Placed {
-                            primitive: Primitive::Box(OrientedBox {
-                                centre: to_cam(&centre_w),
-                                axes,
-                                half: size.map(|s| 0.5 * f64::from(s)),
-                            }),
-                            rect,
-                        });
-                    }
-                }
-                Shape::Tip { .. } | Shape::None => {}
-            }
+        for shape in world_shapes(model, q)? {
+            let Some(rect) = project_rect(camera, shape.hull_corners()) else {
+                continue;
+            };
+            let primitive = match shape {
+                WorldShape::Capsule { a, b, r, .. } => Primitive::Capsule(Capsule {
+                    a: to_cam(&V3f::from(a)),
+                    b: to_cam(&V3f::from(b)),
+                    r: f64::from(r),
+                }),
+                WorldShape::Box {
+                    centre, axes, half, ..
+                } => Primitive::Box(OrientedBox {
+                    centre: to_cam(&V3f::from(centre)),
+                    axes: axes.map(|a| {
+                        let c = camera.r * V3f::from(a);
+                        Vector3::new(f64::from(c.x), f64::from(c.y), f64::from(c.z)).normalize()
+                    }),
+                    half: half.map(f64::from),
+                }),
+            };
+            placed.push(Placed { primitive, rect });
         }
         Ok(Scene { placed })
     }
@@ -140,16 +104,6 @@ impl Scene {
         }
         best
     }
-}
-
-/// The 8 corners of the axis-aligned box around a sphere (world, mm).
-fn sphere_box_corners(centre: &V3f<f32>, r: f32) -> [V3f<f32>; 8] {
-    let mut out = [*centre; 8];
-    for (k, o) in out.iter_mut().enumerate() {
-        let s = |bit: usize| if k & bit == 0 { -r } else { r };
-        *o += V3f::new(s(1), s(2), s(4));
-    }
-    out
 }
 
 /// The pixel rectangle containing the projections of world points `corners` whose convex hull
