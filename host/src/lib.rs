@@ -14,6 +14,8 @@
 //! - [`sim`]: the simulated Linux board on a pseudo-terminal.
 //! - [`overlay`]: the debug overlay (model, slices, edges, tips over a frame) as RGB images.
 //! - [`state_names`]: what each state means, for labels.
+//! - [`mouse_pole`]: the thesis' 3D mouse — the mouse sub-model's states as a pole on the
+//!   table (base mm, height mm) with two buttons.
 //! - [`demo`]: render the `mouse` scenario, stream it to a simulated board over a PTY, and
 //!   evaluate what came back.
 //!
@@ -26,6 +28,7 @@ pub mod demo;
 pub mod eval;
 pub mod link;
 pub mod listen;
+pub mod mouse_pole;
 pub mod overlay;
 pub mod progress;
 pub mod render;
