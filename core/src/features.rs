@@ -214,6 +214,37 @@ pub fn axis_frame(a: &Vector2<f32>, b: &Vector2<f32>) -> (Vector2<f32>, Vector2<
     (dir, Vector2::new(-dir.y, dir.x))
 }
 
+/// What became of one search window of [`find_link_features`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum WindowOutcome {
+    /// Not searched: the predicted edge or tip is hidden by a nearer link or the palm.
+    Masked,
+    /// Not searched: the window leaves the frame.
+    OffFrame,
+    /// Searched; no edge reached the contrast threshold.
+    NoEdge,
+    /// Searched; an edge (or tip) was found and added to the link's features.
+    Found,
+}
+
+/// One search window of [`find_link_features`], where it lies in the image and what became
+/// of it: samples `start + step · k` for `k = 0..samples` (px), `step` a unit vector pointing
+/// outward (away from the axis for a slice, along the axis beyond `b` for a tip).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SearchWindow {
+    /// The first sample (px).
+    pub start: Vector2<f32>,
+    /// From one sample to the next: a unit vector (px).
+    pub step: Vector2<f32>,
+    /// Samples in the window.
+    pub samples: u8,
+    /// Whether this is the window beyond a fingertip (else a slice across the axis).
+    pub tip: bool,
+    /// What the search came to.
+    pub outcome: WindowOutcome,
+}
+
 /// Runs the slice and tip searches for link `index` of `view` on `frame`, into `out`.
 #[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
 pub fn find_link_features(
@@ -223,6 +254,36 @@ pub fn find_link_features(
     index: usize,
     config: &FeatureConfig,
     out: &mut LinkFeatures,
+) {
+    search_link(view, camera, frame, index, config, out, &mut |_| {});
+}
+
+/// [`find_link_features`], also handing `watch` every search window it considered, in
+/// search order (slices from `s = span[0]`, side +1 then −1, then the tip window), masked and
+/// off-frame ones included. The same code as the tracker's search, so a debug view drawn from
+/// it shows exactly what the tracker searched; `out` ends up the same as without `watch`.
+pub fn find_link_features_watched(
+    view: &ProjectedModel,
+    camera: &Camera,
+    frame: &FrameView<'_>,
+    index: usize,
+    config: &FeatureConfig,
+    out: &mut LinkFeatures,
+    mut watch: impl FnMut(&SearchWindow),
+) {
+    search_link(view, camera, frame, index, config, out, &mut watch);
+}
+
+/// The one body of both searches; with a no-op `watch` it compiles to the plain search.
+#[inline(always)]
+fn search_link<W: FnMut(&SearchWindow)>(
+    view: &ProjectedModel,
+    camera: &Camera,
+    frame: &FrameView<'_>,
+    index: usize,
+    config: &FeatureConfig,
+    out: &mut LinkFeatures,
+    watch: &mut W,
 ) {
     out.edges.clear();
     out.tip = None;
@@ -266,12 +327,23 @@ pub fn find_link_features(
     let mut search = |centre: Vector2<f32>,
                       outward: Vector2<f32>,
                       depth: f32,
+                      tip: bool,
                       out: &mut LinkFeatures| {
+        let mut watched = |outcome| {
+            watch(&SearchWindow {
+                start: centre - outward * half,
+                step: outward,
+                samples: window as u8,
+                tip,
+                outcome,
+            })
+        };
         let mut over_hand = false;
         if config.mask_occluded {
             match cover_among(view, camera, &among, palm, &centre, depth) {
                 Cover::Hidden => {
                     out.masked += 1;
+                    watched(WindowOutcome::Masked);
                     return None;
                 }
                 Cover::Behind => over_hand = true,
@@ -285,15 +357,21 @@ pub fn find_link_features(
         let start = centre - outward * half;
         if !frame.sample_segment(start, outward, &mut profile[..window]) {
             out.off_frame += 1;
+            watched(WindowOutcome::OffFrame);
             return None;
         }
         out.expected += 1;
         let edge = if over_hand {
             find_valley(&profile[..window], config.min_contrast)
-                .or_else(|| find_edge(&profile[..window], Polarity::Any, config.min_contrast))?
+                .or_else(|| find_edge(&profile[..window], Polarity::Any, config.min_contrast))
         } else {
-            find_edge(&profile[..window], config.polarity, config.min_contrast)?
+            find_edge(&profile[..window], config.polarity, config.min_contrast)
         };
+        let Some(edge) = edge else {
+            watched(WindowOutcome::NoEdge);
+            return None;
+        };
+        watched(WindowOutcome::Found);
         out.reach_px = out.reach_px.max((edge.position - half).abs());
         Some((start + outward * edge.position, edge.strength))
     };
@@ -304,7 +382,7 @@ pub fn find_link_features(
         for side in [1i8, -1] {
             let outward = normal * f32::from(side);
             let predicted = axis_point + outward * link.side_radius_at(s, side);
-            if let Some((position, strength)) = search(predicted, outward, depth, out) {
+            if let Some((position, strength)) = search(predicted, outward, depth, false, out) {
                 let _ = out.edges.push(EdgePoint {
                     s,
                     side,
@@ -316,7 +394,7 @@ pub fn find_link_features(
     }
     if config.tips && link.distal {
         let predicted = link.b + dir * link.tip_offset;
-        if let Some((position, _)) = search(predicted, dir, link.z1, out) {
+        if let Some((position, _)) = search(predicted, dir, link.z1, true, out) {
             out.tip = Some(position);
         }
     }

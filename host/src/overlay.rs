@@ -8,7 +8,9 @@
 
 use anyhow::{bail, Result};
 use digiteyes_core::camera::Camera;
-use digiteyes_core::features::{find_link_features, FeatureConfig, LinkFeatures};
+use digiteyes_core::features::{
+    find_link_features_watched, FeatureConfig, LinkFeatures, SearchWindow, WindowOutcome,
+};
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Model;
@@ -26,6 +28,8 @@ pub mod colours {
     pub const SILHOUETTE: Rgb<u8> = Rgb([0, 220, 255]);
     /// A search window along a slice (or beyond a tip) that was sampled.
     pub const SLICE: Rgb<u8> = Rgb([40, 70, 200]);
+    /// A search window skipped because its predicted edge is hidden by a nearer part.
+    pub const MASKED: Rgb<u8> = Rgb([130, 0, 130]);
     /// A silhouette edge point found on a slice (a 3×3 px square).
     pub const EDGE: Rgb<u8> = Rgb([255, 40, 40]);
     /// A fingertip found beyond a distal link (a 7 px cross).
@@ -83,17 +87,28 @@ pub fn draw_overlay(
 
     let mut canvas = Canvas::dimmed(frame);
     let mut found = Vec::with_capacity(projected.links.len());
+    let mut windows: Vec<SearchWindow> = Vec::new();
     let mut features = LinkFeatures::default();
     for index in 0..projected.links.len() {
-        find_link_features(
+        find_link_features_watched(
             &projected,
             camera,
             &view_frame,
             index,
             config,
             &mut features,
+            |w| windows.push(*w),
         );
         found.push(features.clone());
+    }
+    for w in &windows {
+        let colour = match w.outcome {
+            WindowOutcome::Masked => colours::MASKED,
+            WindowOutcome::NoEdge | WindowOutcome::Found => colours::SLICE,
+            WindowOutcome::OffFrame => continue,
+        };
+        let end = w.start + w.step * f32::from(w.samples.saturating_sub(1));
+        canvas.line(w.start, end, colour);
     }
     for link in &projected.links {
         let d = link.b - link.a;
@@ -151,34 +166,35 @@ impl Canvas {
         }
     }
 
-    /// A line from `a` to `b` (px), clipped to the image first, then one sample per pixel
-    /// step, so far-off or huge lines cost no more than one across the image.
+    /// A line from `a` to `b` (px), clipped to the image first (in f64, so even a line from
+    /// ±1e9 px is clipped to the pixel), then one sample per pixel step: far-off or huge lines
+    /// cost no more than one across the image.
     fn line(&mut self, a: Vector2<f32>, b: Vector2<f32>, colour: Rgb<u8>) {
-        let Some((a, b)) = self.clip(a, b) else {
+        let Some((a, b)) = self.clip(a.cast(), b.cast()) else {
             return;
         };
         let d = b - a;
         let steps = d.x.abs().max(d.y.abs()).ceil() as usize + 1;
         for i in 0..=steps {
-            let p = a + d * (i as f32 / steps as f32);
-            self.plot(p.x, p.y, colour);
+            let p = a + d * (i as f64 / steps as f64);
+            self.plot(p.x as f32, p.y as f32, colour);
         }
     }
 
     /// Liang–Barsky: the part of segment `a`–`b` inside the image's pixel area
     /// `[−0.5, w − 0.5] × [−0.5, h − 0.5]`, or `None` when none is (or a coordinate is not
     /// finite).
-    fn clip(&self, a: Vector2<f32>, b: Vector2<f32>) -> Option<(Vector2<f32>, Vector2<f32>)> {
+    fn clip(&self, a: Vector2<f64>, b: Vector2<f64>) -> Option<(Vector2<f64>, Vector2<f64>)> {
         if !(a.x.is_finite() && a.y.is_finite() && b.x.is_finite() && b.y.is_finite()) {
             return None;
         }
         let (lo, hi_x, hi_y) = (
             -0.5,
-            self.image.width() as f32 - 0.5,
-            self.image.height() as f32 - 0.5,
+            f64::from(self.image.width()) - 0.5,
+            f64::from(self.image.height()) - 0.5,
         );
         let d = b - a;
-        let (mut t0, mut t1) = (0.0f32, 1.0f32);
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
         for (p, q) in [
             (-d.x, a.x - lo),
             (d.x, hi_x - a.x),
@@ -215,6 +231,241 @@ impl Canvas {
         for k in -arm..=arm {
             self.plot(p.x + k as f32, p.y, colour);
             self.plot(p.x, p.y + k as f32, colour);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::{RenderSettings, Renderer};
+    use crate::sequence::Sequence;
+    use crate::{render_scenario, RenderOptions};
+    use digiteyes_core::features::find_link_features;
+
+    /// Frame 0 of a small `fullhand-mono` render: the sequence, its true state and the frame.
+    fn rendered() -> (tempfile::TempDir, Sequence, Vec<f32>, GrayImage) {
+        let dir = tempfile::tempdir().unwrap();
+        let opts = RenderOptions {
+            frames: Some(1),
+            size: Some((320, 240)),
+            supersample: 2,
+            ..RenderOptions::default()
+        };
+        render_scenario("fullhand-mono", dir.path(), &opts).unwrap();
+        let sequence = Sequence::open(dir.path()).unwrap();
+        let truth = sequence.read_truth().unwrap();
+        let q: Vec<f32> = truth.rows[0].iter().map(|&v| v as f32).collect();
+        let frame = sequence.read_frame(0, 0).unwrap();
+        (dir, sequence, q, frame)
+    }
+
+    fn pixels_of(image: &RgbImage, colour: Rgb<u8>) -> Vec<Vector2<f32>> {
+        image
+            .enumerate_pixels()
+            .filter(|(_, _, p)| **p == colour)
+            .map(|(x, y, _)| Vector2::new(x as f32, y as f32))
+            .collect()
+    }
+
+    fn projected(seq: &Sequence, q: &[f32], config: &FeatureConfig) -> ProjectedModel {
+        let poses = Poses::compute(&seq.model, q).unwrap();
+        let mut view = ProjectedModel::new();
+        view.update(&seq.model, &poses, &seq.cameras[0], config.min_link_px);
+        view
+    }
+
+    #[test]
+    fn model_edges_and_tips_land_where_they_belong() {
+        let (_dir, seq, q, frame) = rendered();
+        let config = FeatureConfig::default();
+        let camera = &seq.cameras[0];
+        let image = draw_overlay(&seq.model, camera, &q, &frame, &config).unwrap();
+        assert_eq!(image.dimensions(), frame.dimensions());
+        let view = projected(&seq, &q, &config);
+
+        // Every axis pixel lies on a projected link axis (within the pixel's half-diagonal).
+        let axis = pixels_of(&image, colours::AXIS);
+        assert!(axis.len() > 100, "{} axis pixels", axis.len());
+        for p in &axis {
+            let d = view
+                .links
+                .iter()
+                .map(|l| l.closest(p).1)
+                .fold(f32::INFINITY, f32::min);
+            assert!(d <= 0.75, "axis pixel {p:?} is {d} px from every axis");
+        }
+        // And the axes are drawn: most points along each one are painted in the axis colour
+        // (edge points and tips may cover a few).
+        let (mut on, mut all) = (0, 0);
+        for l in &view.links {
+            for k in 0..=20 {
+                let p = l.a + (l.b - l.a) * (k as f32 / 20.0);
+                let (x, y) = ((p.x + 0.5) as u32, (p.y + 0.5) as u32);
+                if p.x >= 0.0 && p.y >= 0.0 && x < image.width() && y < image.height() {
+                    all += 1;
+                    on += usize::from(*image.get_pixel(x, y) == colours::AXIS);
+                }
+            }
+        }
+        assert!(on * 10 >= all * 8, "{on} of {all} axis samples painted");
+
+        // The edge points found at the true state lie within 2 px of the true silhouette: the
+        // renderer's coverage boundary, or (where a finger lies over the hand, which the
+        // coverage does not outline) the link's own projected outline.
+        let coverage = Renderer::new(&seq.model, camera, RenderSettings::default())
+            .coverage(&q)
+            .unwrap();
+        let (w, h) = (camera.width as i64, camera.height as i64);
+        let inside = |x: i64, y: i64| {
+            x >= 0 && y >= 0 && x < w && y < h && coverage[(y * w + x) as usize] >= 0.5
+        };
+        let mut boundary = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                let c = coverage[(y * w + x) as usize];
+                let change = inside(x, y) != inside(x + 1, y) || inside(x, y) != inside(x, y + 1);
+                if (c > 0.02 && c < 0.98) || change {
+                    boundary.push(Vector2::new(x as f32, y as f32));
+                }
+            }
+        }
+        let frame_view = FrameView::packed(frame.as_raw(), w as usize, h as usize).unwrap();
+        let mut features = LinkFeatures::default();
+        let (mut points, mut tips, mut outline_only) = (Vec::new(), Vec::new(), 0);
+        for (index, link) in view.links.iter().enumerate() {
+            find_link_features(&view, camera, &frame_view, index, &config, &mut features);
+            for e in &features.edges {
+                let to_coverage = boundary
+                    .iter()
+                    .map(|b| (b - e.position).norm())
+                    .fold(f32::INFINITY, f32::min);
+                let (_, normal) = digiteyes_core::features::axis_frame(&link.a, &link.b);
+                let axis_point = link.a + (link.b - link.a) * e.s;
+                let across = (e.position - axis_point).dot(&normal) * f32::from(e.side);
+                let to_outline = (across - link.side_radius_at(e.s, e.side)).abs();
+                assert!(
+                    to_coverage <= 2.0 || to_outline <= 2.0,
+                    "edge {:?} of link {index}: {to_coverage} px from the silhouette, \
+                     {to_outline} px from its outline",
+                    e.position
+                );
+                outline_only += usize::from(to_coverage > 2.0);
+                points.push(e.position);
+            }
+            tips.extend(features.tip);
+        }
+        assert!(points.len() > 20, "{} edge points", points.len());
+        assert!(
+            outline_only * 4 < points.len(),
+            "{outline_only} edges inside the hand"
+        );
+        // Each is drawn as a 3×3 square of the edge colour (unless a tip cross covers it) and
+        // every edge-coloured pixel belongs to one.
+        let edge_pixels = pixels_of(&image, colours::EDGE);
+        assert!(
+            edge_pixels.len() > 5 * points.len(),
+            "{}",
+            edge_pixels.len()
+        );
+        let pixel = |p: &Vector2<f32>| ((p.x + 0.5).floor(), (p.y + 0.5).floor());
+        for p in &edge_pixels {
+            assert!(
+                points.iter().any(|e| {
+                    let (x, y) = pixel(e);
+                    (x - p.x).abs() <= 1.0 && (y - p.y).abs() <= 1.0
+                }),
+                "edge-coloured pixel {p:?} is not at an edge point"
+            );
+        }
+
+        // The slices searched are drawn, and the fingertips found are crosses centred on
+        // them.
+        assert!(pixels_of(&image, colours::SLICE).len() > 200);
+        assert!(
+            tips.len() >= 3,
+            "{} fingertips found at the true state",
+            tips.len()
+        );
+        for t in &tips {
+            let (x, y) = pixel(t);
+            if x >= 0.0 && y >= 0.0 && x < w as f32 && y < h as f32 {
+                assert_eq!(
+                    *image.get_pixel(x as u32, y as u32),
+                    colours::TIP,
+                    "tip {t:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn bad_input_is_an_error_not_a_panic() {
+        let model = Model::hand().unwrap();
+        let camera = Camera {
+            width: 64,
+            height: 48,
+            fx: 100.0,
+            fy: 100.0,
+            cx: 31.5,
+            cy: 23.5,
+            r: digiteyes_core::nalgebra::Matrix3::identity(),
+            t: digiteyes_core::nalgebra::Vector3::new(0.0, 0.0, 500.0),
+        };
+        let config = FeatureConfig::default();
+        let mut q = vec![0.0f32; model.n_states()];
+        q[0] = 1.0;
+        let frame = GrayImage::new(64, 48);
+        let image = draw_overlay(&model, &camera, &q, &frame, &config).unwrap();
+        assert_eq!(image.dimensions(), (64, 48));
+
+        let wrong = GrayImage::new(65, 48);
+        let e = draw_overlay(&model, &camera, &q, &wrong, &config).unwrap_err();
+        assert!(e.to_string().contains("65x48"), "{e}");
+        let e = draw_overlay(&model, &camera, &q[..7], &frame, &config).unwrap_err();
+        assert!(e.to_string().contains("7 values"), "{e}");
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            let mut q = q.clone();
+            q[9] = bad;
+            let e = draw_overlay(&model, &camera, &q, &frame, &config).unwrap_err();
+            assert!(e.to_string().contains("q9"), "{e}");
+        }
+        let mut zero = q.clone();
+        zero[..4].fill(0.0);
+        assert!(draw_overlay(&model, &camera, &zero, &frame, &config).is_err());
+    }
+
+    #[test]
+    fn lines_are_clipped_to_the_image() {
+        let mut canvas = Canvas::dimmed(&GrayImage::from_pixel(10, 8, image::Luma([100])));
+        assert_eq!(*canvas.image.get_pixel(0, 0), Rgb([50, 50, 50]));
+        // A huge line across the image paints only its part inside, quickly.
+        canvas.line(
+            Vector2::new(-1e9, 3.0),
+            Vector2::new(1e9, 3.0),
+            colours::AXIS,
+        );
+        for x in 0..10 {
+            assert_eq!(*canvas.image.get_pixel(x, 3), colours::AXIS);
+        }
+        assert_eq!(pixels_of(&canvas.image, colours::AXIS).len(), 10);
+        // Lines wholly outside, or not finite, paint nothing.
+        canvas.line(
+            Vector2::new(-5.0, -5.0),
+            Vector2::new(20.0, -3.0),
+            colours::EDGE,
+        );
+        canvas.line(
+            Vector2::new(f32::NAN, 1.0),
+            Vector2::new(5.0, 1.0),
+            colours::EDGE,
+        );
+        canvas.square(Vector2::new(-3.0, -3.0), 1, colours::EDGE);
+        assert!(pixels_of(&canvas.image, colours::EDGE).is_empty());
+        // A diagonal has no gaps.
+        canvas.line(Vector2::new(0.0, 0.0), Vector2::new(7.0, 7.0), colours::TIP);
+        for k in 0..8 {
+            assert_eq!(*canvas.image.get_pixel(k, k), colours::TIP);
         }
     }
 }
