@@ -1,0 +1,215 @@
+//! Where the UI's states come from: a board on a serial port, JSON lines over UDP (what
+//! `digiteyes listen --forward udp://` sends), or a replay of a tracked sequence with its
+//! frames. Each runs on its own thread and writes into the [`Hub`].
+
+use std::net::{SocketAddr, UdpSocket};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context, Result};
+use digiteyes_core::camera::Camera;
+use digiteyes_core::protocol::BoardMessage;
+
+use super::hub::{CameraFrame, Hub, ShownState};
+use crate::link::Link;
+use crate::sequence::states::read_states_with_gaps;
+use crate::sequence::Sequence;
+
+/// Longest UDP datagram read (a `Features` message as JSON is a few KB).
+const MAX_DATAGRAM: usize = 65_536;
+
+/// Reads a board's messages from `link` into `hub` until `stop` is set or the port fails.
+pub fn serial(mut link: Link, hub: &Hub, stop: &AtomicBool) -> Result<()> {
+    while !stop.load(Ordering::Relaxed) {
+        if let Some(message) = link.recv(Duration::from_millis(100))? {
+            hub.push_message(&message);
+        }
+        hub.set_receiver(link.counters());
+    }
+    Ok(())
+}
+
+/// Binds the UDP socket a [`udp`] source reads (port 0 picks a free one).
+pub fn bind_udp(addr: SocketAddr) -> Result<UdpSocket> {
+    let socket = UdpSocket::bind(addr).with_context(|| format!("cannot listen on udp://{addr}"))?;
+    socket
+        .set_read_timeout(Some(Duration::from_millis(100)))
+        .context("cannot set the UDP socket's timeout")?;
+    Ok(socket)
+}
+
+/// Reads JSON lines of board messages (one or more per datagram) from `socket` into `hub`
+/// until `stop` is set. Lines that are not a board message are counted, not fatal.
+pub fn udp(socket: &UdpSocket, hub: &Hub, stop: &AtomicBool) -> Result<()> {
+    let mut buf = vec![0u8; MAX_DATAGRAM];
+    while !stop.load(Ordering::Relaxed) {
+        let n = match socket.recv_from(&mut buf) {
+            Ok((n, _)) => n,
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) =>
+            {
+                continue
+            }
+            Err(e) => return Err(e).context("UDP receive failed"),
+        };
+        let Ok(text) = std::str::from_utf8(&buf[..n]) else {
+            hub.push_unreadable();
+            continue;
+        };
+        for line in text.lines().filter(|l| !l.trim().is_empty()) {
+            match serde_json::from_str::<BoardMessage>(line) {
+                Ok(message) => hub.push_message(&message),
+                Err(_) => hub.push_unreadable(),
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A tracked sequence played back: its frames with the states a tracker wrote for them.
+#[derive(Debug)]
+pub struct Replay {
+    sequence: Sequence,
+    states: Vec<(ShownState, Option<String>)>,
+    camera: Camera,
+    camera_index: usize,
+    period: Duration,
+}
+
+impl Replay {
+    /// Opens `seqdir` and `states_csv` (the output of `track` or `stream`), to be shown as
+    /// camera `camera_index` saw it, at the sequence's frame rate (`fps` overrides; 15 when
+    /// neither gives one).
+    pub fn open(
+        seqdir: &Path,
+        states_csv: &Path,
+        camera_index: usize,
+        fps: Option<f64>,
+    ) -> Result<Replay> {
+        let sequence = Sequence::open(seqdir)?;
+        let Some(camera) = sequence.cameras.get(camera_index).copied() else {
+            bail!(
+                "{}: no camera {camera_index} (the sequence has {})",
+                seqdir.display(),
+                sequence.cameras.len()
+            );
+        };
+        let table = read_states_with_gaps(states_csv, sequence.n_states())?;
+        let column = |name: &str| table.table.extra(name);
+        let rows = table.table.rows.len();
+        let lost = column("lost").unwrap_or_else(|| vec![0.0; rows]);
+        let rms = column("rms_px").unwrap_or_else(|| vec![f64::NAN; rows]);
+        let found = column("features_found").unwrap_or_else(|| vec![0.0; rows]);
+        let expected = column("features_expected").unwrap_or_else(|| vec![0.0; rows]);
+        let iterations = column("iterations").unwrap_or_else(|| vec![0.0; rows]);
+        let dropped = table.extra_text("dropped");
+        let states = (0..rows)
+            .map(|i| {
+                let shown = ShownState {
+                    frame: i as u32,
+                    q: table.table.rows[i].iter().map(|&v| v as f32).collect(),
+                    lost: lost[i] != 0.0,
+                    rms_px: rms[i] as f32,
+                    features_found: found[i] as u16,
+                    features_expected: expected[i] as u16,
+                    iterations: iterations[i] as u8,
+                };
+                let drop = dropped
+                    .as_ref()
+                    .map(|d| d[i].to_string())
+                    .filter(|d| !d.is_empty());
+                (shown, drop)
+            })
+            .collect();
+        let fps = fps.or(sequence.fps()).unwrap_or(15.0);
+        if !(fps > 0.0 && fps.is_finite()) {
+            bail!("replay rate {fps} frames/s: must be above 0");
+        }
+        Ok(Replay {
+            sequence,
+            states,
+            camera,
+            camera_index,
+            period: Duration::from_secs_f64(1.0 / fps),
+        })
+    }
+
+    /// The sequence's folder.
+    pub fn dir(&self) -> PathBuf {
+        self.sequence.dir.clone()
+    }
+
+    /// The free states of the sequence.
+    pub fn free(&self) -> Vec<usize> {
+        self.sequence.free_states()
+    }
+
+    /// The sequence's initial state.
+    pub fn initial_state(&self) -> Vec<f32> {
+        self.sequence
+            .initial_state
+            .iter()
+            .map(|&v| v as f32)
+            .collect()
+    }
+
+    /// Frames in the replay.
+    pub fn len(&self) -> usize {
+        self.states.len()
+    }
+
+    /// True when the states file has no frames.
+    pub fn is_empty(&self) -> bool {
+        self.states.is_empty()
+    }
+
+    /// Plays the frames into `hub`, from the first again after the last, until `stop`.
+    pub fn play(&self, hub: &Hub, stop: &AtomicBool) -> Result<()> {
+        if self.states.is_empty() {
+            return Ok(());
+        }
+        let mut next = Instant::now();
+        for (i, (state, drop)) in self.states.iter().enumerate().cycle() {
+            if stop.load(Ordering::Relaxed) {
+                break;
+            }
+            let image = self.sequence.read_frame(self.camera_index, i)?;
+            hub.push_frame(CameraFrame {
+                frame: state.frame,
+                camera: self.camera,
+                image,
+                q: state.q.clone(),
+            });
+            match drop {
+                Some(reason) => hub.push_host_drop(reason),
+                None => hub.push_state(state.clone()),
+            }
+            next += self.period;
+            let now = Instant::now();
+            if next > now {
+                // Pacing the replay at the sequence's frame rate, not waiting for an event.
+                std::thread::sleep(next - now);
+            } else {
+                next = now;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A source's thread: runs `body` and, if it fails, keeps the error for the caller.
+pub fn spawn(
+    name: &str,
+    stop: Arc<AtomicBool>,
+    body: impl FnOnce(&AtomicBool) -> Result<()> + Send + 'static,
+) -> Result<std::thread::JoinHandle<Result<()>>> {
+    std::thread::Builder::new()
+        .name(name.into())
+        .spawn(move || body(&stop))
+        .with_context(|| format!("cannot start the {name} thread"))
+}
