@@ -59,6 +59,46 @@ pub fn read_states(path: &Path, n_states: usize) -> Result<StateTable> {
 
 /// Parses the text of a state CSV (see [`read_states`]).
 pub fn parse_states(text: &str, n_states: usize) -> Result<StateTable> {
+    parse_table(text, n_states, false).map(|s| s.table)
+}
+
+/// A state CSV read by [`read_states_with_gaps`]: states that are not numbers are kept as
+/// NaN, and the extra columns' text is kept too (e.g. `stream`'s `dropped` reasons).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StatesWithGaps {
+    /// The states and extra columns; a state that is not a finite number is NaN.
+    pub table: StateTable,
+    /// The text of every extra column (trimmed), one vector per frame.
+    pub extra_text: Vec<Vec<String>>,
+}
+
+impl StatesWithGaps {
+    /// The text of extra column `name`, one string per frame, if the file has it.
+    pub fn extra_text(&self, name: &str) -> Option<Vec<&str>> {
+        let i = self.table.extra_columns.iter().position(|c| c == name)?;
+        Some(self.extra_text.iter().map(|row| row[i].as_str()).collect())
+    }
+
+    /// The frames with at least one state that is not a finite number, in order.
+    pub fn gap_frames(&self) -> Vec<usize> {
+        let rows = self.table.rows.iter().enumerate();
+        rows.filter(|(_, row)| row.iter().any(|v| !v.is_finite()))
+            .map(|(k, _)| k)
+            .collect()
+    }
+}
+
+/// Reads a state CSV like [`read_states`], but a state that is not a finite number (`nan`,
+/// `inf`, empty, text) becomes NaN instead of an error, for reports that show such frames as
+/// gaps. The header, field counts and frame numbers are checked as strictly.
+pub fn read_states_with_gaps(path: &Path, n_states: usize) -> Result<StatesWithGaps> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    parse_table(&text, n_states, true).with_context(|| format!("{}", path.display()))
+}
+
+/// Parses a state CSV; with `gaps`, states that are not finite numbers become NaN.
+fn parse_table(text: &str, n_states: usize, gaps: bool) -> Result<StatesWithGaps> {
     let mut lines = text
         .lines()
         .enumerate()
@@ -92,6 +132,7 @@ pub fn parse_states(text: &str, n_states: usize) -> Result<StateTable> {
         extra_columns,
         extras: Vec::new(),
     };
+    let mut extra_text = Vec::new();
     for (index, line) in lines {
         let number = index + 1;
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
@@ -115,6 +156,7 @@ pub fn parse_states(text: &str, n_states: usize) -> Result<StateTable> {
         for (i, field) in fields[1..=n_states].iter().enumerate() {
             match field.parse::<f64>() {
                 Ok(v) if v.is_finite() => state.push(v),
+                _ if gaps => state.push(f64::NAN),
                 _ => bail!("line {number}: q{i} = `{field}` is not a finite number"),
             }
         }
@@ -124,8 +166,14 @@ pub fn parse_states(text: &str, n_states: usize) -> Result<StateTable> {
             .collect();
         table.rows.push(state);
         table.extras.push(extras);
+        extra_text.push(
+            fields[n_states + 1..]
+                .iter()
+                .map(|f| f.to_string())
+                .collect(),
+        );
     }
-    Ok(table)
+    Ok(StatesWithGaps { table, extra_text })
 }
 
 /// Writes `truth.csv`: the header `frame,q0..` and one row per frame.
@@ -314,5 +362,22 @@ mod tests {
         assert!(err("frame,q0,q1\n1,1,2\n").contains("expected frame 0"));
         assert!(err("frame,q0,q1\n0,1,x\n").contains("q1"));
         assert!(err("frame,q0,q1\n0,1,2\n1,1,nan\n").contains("line 3"));
+    }
+
+    #[test]
+    fn gaps_are_kept_as_nan_with_the_extra_text() {
+        let text = "frame,q0,q1,lost,dropped\n0,1,2,0,\n1,nan,,1,no reply (timeout)\n";
+        let read = parse_table(text, 2, true).unwrap();
+        assert_eq!(read.table.rows[0], vec![1.0, 2.0]);
+        assert!(read.table.rows[1].iter().all(|v| v.is_nan()));
+        assert_eq!(read.gap_frames(), vec![1]);
+        assert_eq!(
+            read.extra_text("dropped").unwrap(),
+            vec!["", "no reply (timeout)"]
+        );
+        assert_eq!(read.table.extra("lost").unwrap(), vec![0.0, 1.0]);
+        // The structure is checked as strictly as without gaps.
+        assert!(parse_table("frame,q0,q1\n0,1\n", 2, true).is_err());
+        assert!(parse_table("frame,q0,q1\n1,1,2\n", 2, true).is_err());
     }
 }
