@@ -155,6 +155,21 @@ fn demo_renders_tracks_and_evaluates() {
         "{report}"
     );
     assert!(keep.join("states.csv").is_file() && keep.join("cam0/000003.pgm").is_file());
+    // It ends by saying where the report and the UI are; not in a terminal, it does not
+    // serve the UI but prints the command that does.
+    let report_html = keep.join("report.html");
+    assert!(report_html.is_file(), "no report.html");
+    let lines: Vec<&str> = report.lines().collect();
+    let n = lines.len();
+    assert!(
+        n >= 2 && lines[n - 2] == format!("report: {}", report_html.display()),
+        "{report}"
+    );
+    assert!(
+        lines[n - 1].starts_with(&format!("UI: digiteyes ui --replay {}", keep.display()))
+            && lines[n - 1].contains("http://127.0.0.1:"),
+        "{report}"
+    );
 }
 
 #[test]
