@@ -39,6 +39,11 @@ pub struct MousePole {
     pub y_mm: f32,
     /// The pole's height: finger 1's fingertip surface above the table (mm, >= 0).
     pub height_mm: f32,
+    /// Finger 1's fingertip surface: its world z (mm), not clamped. Below 0 the fingertip is
+    /// below the table plane — possible in synthetic scenes, which have no table to stop it
+    /// (the `mouse` scenario's curled finger 1 reaches a few mm below z = 0), so the pole
+    /// stays at 0 while this still follows the finger.
+    pub tip_z_mm: f32,
     /// The buttons: `[finger 4 abduction, thumb abduction]` by default; `true` = pressed.
     pub buttons: [bool; 2],
 }
@@ -150,6 +155,7 @@ impl MouseMapper {
             x_mm: q[BASE_STATES[0]],
             y_mm: q[BASE_STATES[1]],
             height_mm: (tip_z - self.tip_radius_mm).max(0.0),
+            tip_z_mm: tip_z - self.tip_radius_mm,
             buttons: self.pressed,
         })
     }
@@ -308,6 +314,12 @@ mod tests {
                 pole.height_mm
             );
             assert!(pole.height_mm >= 0.0);
+            assert!(
+                (f64::from(pole.tip_z_mm) - (tip[2] - TIP_RADIUS)).abs() < 1e-3,
+                "q8 = {}: fingertip surface at {} mm",
+                q[8],
+                pole.tip_z_mm
+            );
             if expected > 0.0 {
                 assert!(
                     pole.height_mm < last,
@@ -321,7 +333,10 @@ mod tests {
         // Curled far enough, the fingertip reaches the table: the pole stops at 0.
         (q[8], q[9], q[10]) = (1.4, 1.2, 0.6);
         assert!(finger1_tip_f64(&q)[2] < TIP_RADIUS);
-        assert_eq!(mouse.update(&q).unwrap().height_mm, 0.0);
+        let pole = mouse.update(&q).unwrap();
+        assert_eq!(pole.height_mm, 0.0);
+        // ... while the fingertip's own height goes on following the finger below it.
+        assert!(pole.tip_z_mm < 0.0, "{}", pole.tip_z_mm);
     }
 
     #[test]
@@ -412,11 +427,12 @@ mod tests {
             x_mm: 1.5,
             y_mm: -2.0,
             height_mm: 30.0,
+            tip_z_mm: 30.0,
             buttons: [true, false],
         };
         assert_eq!(
             serde_json::to_string(&pole).unwrap(),
-            r#"{"x_mm":1.5,"y_mm":-2.0,"height_mm":30.0,"buttons":[true,false]}"#
+            r#"{"x_mm":1.5,"y_mm":-2.0,"height_mm":30.0,"tip_z_mm":30.0,"buttons":[true,false]}"#
         );
     }
 }

@@ -190,6 +190,7 @@ mod tests {
             x_mm: 1.5,
             y_mm: -2.0,
             height_mm: 33.5,
+            tip_z_mm: 33.5,
             buttons: [false, true],
         };
         let bytes = encode(&state_bundle(&state(12, &q), &q, Some(&mouse))).unwrap();

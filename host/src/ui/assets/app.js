@@ -276,7 +276,8 @@ function updatePanels() {
 
   const m = snap.mouse;
   $("mouse-values").textContent = m
-    ? `base (${m.x_mm.toFixed(1)}, ${m.y_mm.toFixed(1)}) mm · height ${m.height_mm.toFixed(1)} mm · ` +
+    ? `base (${m.x_mm.toFixed(1)}, ${m.y_mm.toFixed(1)}) mm · height ${m.height_mm.toFixed(1)} mm ` +
+      `(fingertip at z ${m.tip_z_mm.toFixed(1)} mm) · ` +
       `buttons: finger 4 ${m.buttons[0] ? "DOWN" : "up"}, thumb ${m.buttons[1] ? "DOWN" : "up"}`
     : "no mouse reading: it needs the built-in hand model";
 
