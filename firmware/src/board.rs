@@ -11,7 +11,7 @@ use digiteyes_core::protocol::{
     Dropped, Features, FrameChunk, Hello, HostMessage, Refusal, Reset, State, Stats, MAX_CHUNK,
     MAX_MESSAGE, PROTOCOL_VERSION,
 };
-use digiteyes_core::tracker::{Tracker, TrackerConfig, TrackerError};
+use digiteyes_core::tracker::{FrameReport, Tracker, TrackerConfig, TrackerError};
 use embedded_hal::delay::DelayNs;
 use embedded_hal::digital::OutputPin;
 use embedded_io::{Read, ReadReady, Write};
@@ -35,6 +35,29 @@ struct Setup {
     stats_every: u16,
 }
 
+/// A frame the board has just tracked, as its [`Board::set_tap`] tap sees it: handed over
+/// right after tracking and before the frame's `State` is sent, so a host that has the state
+/// knows the tap has had the frame.
+#[derive(Debug, Clone, Copy)]
+pub struct Tracked<'a> {
+    /// The frame's number (as uploaded, or the camera source's).
+    pub frame: u32,
+    /// The camera it was tracked with (as configured).
+    pub camera: &'a Camera,
+    /// The tracker parameters it was tracked with (as configured).
+    pub config: &'a TrackerConfig,
+    /// The frame: 8-bit grey, packed, `camera.width × camera.height`.
+    pub pixels: &'a [u8],
+    /// The state tracked (the `State` message's `q`: quaternion, mm, rad).
+    pub q: &'a [f32],
+    /// What the tracker reported for it.
+    pub report: &'a FrameReport,
+}
+
+/// Where a board hands each tracked frame ([`Board::set_tap`]). It runs inside the board
+/// loop: whatever it does delays the frame's `State`.
+pub type Tap<'m> = &'m mut (dyn FnMut(&Tracked<'_>) + Send);
+
 /// Everything but the receiver, so a received message (which borrows the receiver's buffer)
 /// can be handled while the rest of the board changes.
 struct Node<'m, S, F, L, C> {
@@ -43,6 +66,7 @@ struct Node<'m, S, F, L, C> {
     frame: &'m mut [u8],
     overlay: Option<&'m mut [u8]>,
     overlay_ready: bool,
+    tap: Option<Tap<'m>>,
     serial: S,
     source: F,
     led: L,
@@ -87,6 +111,7 @@ where
                 frame: frame_buffer,
                 overlay,
                 overlay_ready: false,
+                tap: None,
                 serial,
                 source,
                 led,
@@ -163,6 +188,12 @@ where
             .as_deref()
             .filter(|_| self.node.overlay_ready)?
             .get(..n)
+    }
+
+    /// Hands every frame the board tracks from now on to `tap` (a debug view, a recorder),
+    /// replacing any earlier tap. Frames dropped untracked are not handed over.
+    pub fn set_tap(&mut self, tap: Tap<'m>) {
+        self.node.tap = Some(tap);
     }
 
     /// The serial port (e.g. to inject bytes in a test).
@@ -356,6 +387,16 @@ where
         if let Some(out) = self.overlay.as_deref_mut() {
             overlay::draw(tracker.model(), &setup.camera, tracker.state(), pixels, out);
             self.overlay_ready = true;
+        }
+        if let Some(tap) = self.tap.as_deref_mut() {
+            tap(&Tracked {
+                frame,
+                camera: &setup.camera,
+                config: &setup.config,
+                pixels,
+                q: &q,
+                report: &report,
+            });
         }
         let measurements = (setup.features_every != 0
             && self.stats.frames % u32::from(setup.features_every) == 0)

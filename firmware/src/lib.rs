@@ -28,7 +28,7 @@ pub mod overlay;
 mod source;
 mod upload;
 
-pub use board::Board;
+pub use board::{Board, Tap, Tracked};
 pub use clock::Clock;
 pub use led::NoLed;
 pub use source::{FrameSource, SourceError, Uploads};

@@ -30,7 +30,7 @@ pub use clock::MonotonicClock;
 pub use frame_size::parse_frame_size;
 pub use led::StatusLed;
 pub use serial::TtySerial;
-pub use sim::{Corruption, SimBoard, SimOptions, SimReport, Window};
+pub use sim::{Corruption, FrameTap, SimBoard, SimFrame, SimOptions, SimReport, TapMode, Window};
 pub use source::Source;
 
 /// The board name a Linux board reports in `Hello`.

@@ -5,9 +5,13 @@
 //! For robustness tests the line can be noisy ([`Corruption`]) and the board can be
 //! power-cycled once mid-run ([`SimOptions::restart_after`]): the [`Board`] is dropped and a
 //! new one boots on the same PTY, losing whatever it had received of the frame in flight.
+//!
+//! A host can also see what the board tracks: with [`SimOptions::frame_tap`] every tracked
+//! frame comes back as a [`SimFrame`] (pixels, the state sent, camera) over a channel.
 
 mod corrupt;
 mod line;
+mod tap;
 
 use std::cell::RefCell;
 use std::fmt;
@@ -20,10 +24,11 @@ use std::thread::JoinHandle;
 use std::time::Duration;
 
 use digiteyes_core::protocol::Stats;
-use digiteyes_firmware::{Board, NoLed, Uploads};
+use digiteyes_firmware::{Board, NoLed, Tracked, Uploads};
 use serialport::{SerialPort, TTYPort};
 
 pub use corrupt::{Corruption, Window};
+pub use tap::{FrameTap, SimFrame, TapMode};
 
 use crate::clock::MonotonicClock;
 use crate::serial::TtySerial;
@@ -51,6 +56,8 @@ pub struct SimOptions {
     /// Power-cycle the board once, right after it has received the first chunk of the frame
     /// that follows this many uploaded frames.
     pub restart_after: Option<u32>,
+    /// Where to hand every tracked frame, if anywhere.
+    pub frame_tap: Option<FrameTap>,
 }
 
 impl Default for SimOptions {
@@ -59,6 +66,7 @@ impl Default for SimOptions {
             frame_buffer_bytes: 640 * 480,
             corruption: None,
             restart_after: None,
+            frame_tap: None,
         }
     }
 }
@@ -73,6 +81,12 @@ impl SimOptions {
     /// With one power cycle after `frames` uploaded frames.
     pub fn restart_after(mut self, frames: u32) -> Self {
         self.restart_after = Some(frames);
+        self
+    }
+
+    /// Handing every tracked frame to `tap` (before the frame's `State` goes out).
+    pub fn frame_tap(mut self, tap: FrameTap) -> Self {
+        self.frame_tap = Some(tap);
         self
     }
 
@@ -100,6 +114,11 @@ pub struct SimReport {
     pub discarded_out: u64,
     /// Serial errors the board loop returned (the loop goes on after each).
     pub serial_errors: u64,
+    /// Tracked frames handed to the [`FrameTap`].
+    pub tapped: u64,
+    /// Tracked frames the [`FrameTap`] could not hand over (channel full in
+    /// [`TapMode::Skip`], receiver gone, or the board stopped while waiting).
+    pub tap_skipped: u64,
     /// The current board's counters (since its last boot).
     pub board: Stats,
 }
@@ -117,7 +136,15 @@ impl fmt::Display for SimReport {
             self.discarded_out,
             self.restarts,
             self.serial_errors
-        )
+        )?;
+        if self.tapped + self.tap_skipped > 0 {
+            write!(
+                f,
+                "; frame tap: {} frame(s) handed over, {} skipped",
+                self.tapped, self.tap_skipped
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -232,7 +259,14 @@ fn run(
             f(&mut r);
         }
     };
+    let mut boot = 0u32;
     loop {
+        let tap = options.frame_tap.clone();
+        let mut hand = move |tracked: &Tracked<'_>| {
+            if let Some(tap) = &tap {
+                tap.hand(tracked, boot, stop, report);
+            }
+        };
         let mut board = Board::new(
             SIM_BOARD_NAME,
             &mut frame_buffer,
@@ -242,6 +276,9 @@ fn run(
             NoLed,
             MonotonicClock::new(),
         );
+        if options.frame_tap.is_some() {
+            board.set_tap(&mut hand);
+        }
         if board.start().is_err() {
             note(&|r| r.serial_errors += 1);
         }
@@ -269,5 +306,6 @@ fn run(
         }
         drop(board);
         line.borrow_mut().power_cycled();
+        boot += 1;
     }
 }
