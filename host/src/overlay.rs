@@ -6,7 +6,12 @@
 //! `core::measurement` runs it), so the overlay shows exactly what the tracker would measure
 //! at `q` with `config`'s full window (the tracker's later iterations of a frame narrow it).
 
-use anyhow::{bail, Result};
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{sync_channel, SyncSender};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use anyhow::{anyhow, bail, Context, Result};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::features::{
     find_link_features_watched, FeatureConfig, LinkFeatures, SearchWindow, WindowOutcome,
@@ -18,6 +23,8 @@ use digiteyes_core::nalgebra::Vector2;
 use digiteyes_core::projection::ProjectedModel;
 use image::{GrayImage, Rgb, RgbImage};
 
+use crate::sequence::camera_dir_name;
+
 /// The overlay's colours (RGB).
 pub mod colours {
     use image::Rgb;
@@ -27,9 +34,9 @@ pub mod colours {
     /// A link's two projected silhouette lines.
     pub const SILHOUETTE: Rgb<u8> = Rgb([0, 220, 255]);
     /// A search window along a slice (or beyond a tip) that was sampled.
-    pub const SLICE: Rgb<u8> = Rgb([40, 70, 200]);
+    pub const SLICE: Rgb<u8> = Rgb([30, 55, 160]);
     /// A search window skipped because its predicted edge is hidden by a nearer part.
-    pub const MASKED: Rgb<u8> = Rgb([130, 0, 130]);
+    pub const MASKED: Rgb<u8> = Rgb([120, 0, 120]);
     /// A silhouette edge point found on a slice (a 3×3 px square).
     pub const EDGE: Rgb<u8> = Rgb([255, 40, 40]);
     /// A fingertip found beyond a distal link (a 7 px cross).
@@ -135,6 +142,114 @@ pub fn draw_overlay(
         }
     }
     Ok(canvas.image)
+}
+
+/// Where the overlay of frame `frame` of camera `cam` goes under `dir`:
+/// `dir/cam{cam}/{frame:06}.png`, the sequence's frame naming with `.png`.
+pub fn overlay_path(dir: &Path, cam: usize, frame: usize) -> PathBuf {
+    dir.join(camera_dir_name(cam))
+        .join(format!("{frame:06}.png"))
+}
+
+/// Overlay PNGs written on a thread of their own, so encoding overlaps the caller's work.
+/// [`PngWriter::write`] waits when `queue` images are pending; the first failure stops the
+/// writer and is returned by the next `write` or by [`PngWriter::finish`].
+#[derive(Debug)]
+pub struct PngWriter {
+    sender: Option<SyncSender<(PathBuf, RgbImage)>>,
+    thread: Option<JoinHandle<Result<PngStats>>>,
+}
+
+/// What a [`PngWriter`] wrote.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PngStats {
+    /// Files written.
+    pub files: usize,
+    /// Time spent encoding and writing them, on the writer's thread (s).
+    pub seconds: f64,
+}
+
+impl PngWriter {
+    /// Starts the writer thread, with room for `queue` pending images (at least 1).
+    pub fn start(queue: usize) -> Result<Self> {
+        let (sender, receiver) = sync_channel::<(PathBuf, RgbImage)>(queue.max(1));
+        let thread = std::thread::Builder::new()
+            .name("digiteyes-overlay-png".into())
+            .spawn(move || {
+                let mut stats = PngStats::default();
+                let mut busy = Duration::ZERO;
+                let mut made: Option<PathBuf> = None;
+                for (path, image) in receiver {
+                    let t0 = Instant::now();
+                    write_png(&path, &image, &mut made)?;
+                    busy += t0.elapsed();
+                    stats.files += 1;
+                }
+                stats.seconds = busy.as_secs_f64();
+                Ok(stats)
+            })
+            .context("cannot start the overlay writer thread")?;
+        Ok(PngWriter {
+            sender: Some(sender),
+            thread: Some(thread),
+        })
+    }
+
+    /// Queues `image` to be written to `path` (its folder is created). Fails with the
+    /// writer's error if an earlier write failed.
+    pub fn write(&mut self, path: PathBuf, image: RgbImage) -> Result<()> {
+        let sent = self
+            .sender
+            .as_ref()
+            .is_some_and(|s| s.send((path, image)).is_ok());
+        if sent {
+            return Ok(());
+        }
+        // The writer stopped: its error says why.
+        self.join()?;
+        Err(anyhow!("the overlay writer stopped"))
+    }
+
+    /// Waits until every queued image is written; what was written, or the first failure.
+    pub fn finish(mut self) -> Result<PngStats> {
+        self.join()
+    }
+
+    fn join(&mut self) -> Result<PngStats> {
+        self.sender = None;
+        match self.thread.take() {
+            Some(thread) => thread
+                .join()
+                .map_err(|_| anyhow!("the overlay writer panicked"))?,
+            None => Err(anyhow!("the overlay writer has already stopped")),
+        }
+    }
+}
+
+/// Writes `image` to `path` as PNG, creating its folder unless it is `made` (the last one
+/// created, updated).
+pub(crate) fn write_png(path: &Path, image: &RgbImage, made: &mut Option<PathBuf>) -> Result<()> {
+    if let Some(parent) = path.parent() {
+        if made.as_deref() != Some(parent) {
+            std::fs::create_dir_all(parent).with_context(|| {
+                format!("cannot create the overlay folder {}", parent.display())
+            })?;
+            *made = Some(parent.to_path_buf());
+        }
+    }
+    image
+        .save_with_format(path, image::ImageFormat::Png)
+        .with_context(|| format!("cannot write overlay {}", path.display()))
+}
+
+impl Drop for PngWriter {
+    /// Waits for the queued images (so none is left half written); errors are for `finish`.
+    fn drop(&mut self) {
+        self.sender = None;
+        if let Some(thread) = self.thread.take() {
+            let _ = thread.join();
+        }
+    }
 }
 
 /// An RGB image with a clipped line and point painter. Coordinates are px with (0, 0) the

@@ -1,10 +1,21 @@
-//! `digiteyes sim`: a simulated Linux board on a pseudo-terminal, for a host to connect to.
+//! `digiteyes sim`: a simulated Linux board on a pseudo-terminal, for a host to connect to;
+//! with `--overlay`, every frame it tracks drawn at the state it sent ([`overlay_tap`]).
 
 use std::ops::Range;
-use std::time::Duration;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{sync_channel, Receiver};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 
-use anyhow::{bail, Context, Result};
-use digiteyes_board_linux::{Corruption, SimBoard, SimOptions, Window};
+use anyhow::{anyhow, bail, Context, Result};
+use digiteyes_board_linux::{Corruption, FrameTap, SimBoard, SimFrame, SimOptions, Window};
+use digiteyes_core::model::Model;
+use image::GrayImage;
+
+use crate::overlay::{draw_overlay, overlay_path, write_png};
+
+/// Tracked frames the overlay writer may fall behind the board by before the board waits.
+pub const OVERLAY_QUEUE: usize = 32;
 
 /// Line noise from the command line: `rate` of the bytes, in `frames` (all when `None`).
 pub fn corruption(rate: f64, frames: Option<Range<u32>>, seed: u64) -> Result<Corruption> {
@@ -58,6 +69,83 @@ pub fn serve(board: SimBoard, every: Option<Duration>) -> Result<()> {
         },
     }
     Ok(())
+}
+
+/// What an [`OverlayWriter`] did.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct OverlayStats {
+    /// PNGs written.
+    pub files: usize,
+    /// Frames that could not be drawn (each reported on stderr).
+    pub undrawable: usize,
+    /// Time spent drawing, encoding and writing (s), on the writer's thread.
+    pub seconds: f64,
+}
+
+/// The thread that draws a simulated board's tracked frames as overlay PNGs.
+#[derive(Debug)]
+pub struct OverlayWriter {
+    thread: JoinHandle<Result<OverlayStats>>,
+}
+
+impl OverlayWriter {
+    /// Waits until the board is gone (its tap closed) and every frame is written; what was
+    /// written, or the first write failure.
+    pub fn finish(self) -> Result<OverlayStats> {
+        self.thread
+            .join()
+            .map_err(|_| anyhow!("the overlay writer panicked"))?
+    }
+}
+
+/// A frame tap for [`SimOptions::frame_tap`] and the thread that draws what it hands over:
+/// each tracked frame at the state the board sent for it, with the board's model (the
+/// built-in hand) and search parameters, into `dir/cam0/NNNNNN.png`, NNNNNN the frame's
+/// number as uploaded (a board sees one camera). Every frame is drawn: the board waits when
+/// [`OVERLAY_QUEUE`] frames are pending. A frame that cannot be drawn is reported on stderr
+/// and skipped; a write failure stops the writer (reported on stderr and by
+/// [`OverlayWriter::finish`]) and the board counts the frames after it as skipped.
+pub fn overlay_tap(dir: &Path) -> Result<(FrameTap, OverlayWriter)> {
+    let model = Model::hand().map_err(|e| anyhow!("built-in hand model: {e}"))?;
+    let (sender, receiver) = sync_channel(OVERLAY_QUEUE);
+    let dir = dir.to_path_buf();
+    let thread = std::thread::Builder::new()
+        .name("digiteyes-sim-overlay".into())
+        .spawn(move || {
+            let result = write_overlays(&model, &dir, &receiver);
+            if let Err(e) = &result {
+                eprintln!("digiteyes sim: overlays stopped: {e:#}");
+            }
+            result
+        })
+        .context("cannot start the overlay writer thread")?;
+    Ok((FrameTap::every(sender), OverlayWriter { thread }))
+}
+
+fn write_overlays(model: &Model, dir: &Path, frames: &Receiver<SimFrame>) -> Result<OverlayStats> {
+    let mut stats = OverlayStats::default();
+    let mut busy = Duration::ZERO;
+    let mut made: Option<PathBuf> = None;
+    for f in frames {
+        let t0 = Instant::now();
+        let bytes = f.pixels.len();
+        let drawn = GrayImage::from_raw(f.width, f.height, f.pixels)
+            .ok_or_else(|| anyhow!("{bytes} bytes is not a {}x{} frame", f.width, f.height))
+            .and_then(|frame| draw_overlay(model, &f.camera, &f.q, &frame, &f.features));
+        match drawn {
+            Ok(image) => {
+                write_png(&overlay_path(dir, 0, f.frame as usize), &image, &mut made)?;
+                stats.files += 1;
+            }
+            Err(e) => {
+                eprintln!("digiteyes sim: frame {}: no overlay: {e:#}", f.frame);
+                stats.undrawable += 1;
+            }
+        }
+        busy += t0.elapsed();
+    }
+    stats.seconds = busy.as_secs_f64();
+    Ok(stats)
 }
 
 #[cfg(test)]

@@ -4,6 +4,8 @@
 //! of every camera: one `track` call per instant with one frame per camera. Each instant's
 //! state and report go to the output CSV as soon as it is tracked (header
 //! `frame,q0..q{n-1},rms_px,iterations,features_found,features_expected,lost`).
+//! Optionally each frame of each camera is also drawn with the model, the slices searched and
+//! the features found at the state tracked for it ([`crate::overlay`]), as PNGs.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -13,6 +15,7 @@ use anyhow::{anyhow, Context, Result};
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
 
+use crate::overlay::{draw_overlay, overlay_path, PngStats, PngWriter};
 use crate::sequence::{Sequence, StatesWriter};
 
 /// What a tracking run did.
@@ -34,6 +37,8 @@ pub struct TrackSummary {
     pub out: PathBuf,
     /// The sequence's frame rate (frames/s), when `sequence.json` gives one.
     pub fps: Option<f64>,
+    /// The overlay PNGs written, when asked for: where, and the writer's figures.
+    pub overlays: Option<(PathBuf, PngStats)>,
 }
 
 impl TrackSummary {
@@ -65,7 +70,17 @@ impl fmt::Display for TrackSummary {
             )?,
             _ => writeln!(f)?,
         }
-        write!(f, "states written to {}", self.out.display())
+        write!(f, "states written to {}", self.out.display())?;
+        if let Some((dir, png)) = &self.overlays {
+            write!(
+                f,
+                "\noverlays: {} PNG(s) written to {} ({:.1} ms each to encode and write)",
+                png.files,
+                dir.display(),
+                1e3 * png.seconds / png.files.max(1) as f64
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -95,12 +110,26 @@ pub fn track_sequence(
     config: TrackerConfig,
     progress: bool,
 ) -> Result<TrackSummary> {
+    track_sequence_with(seq, out_csv, config, progress, None)
+}
+
+/// [`track_sequence`], and when `overlay_dir` is given, each frame of each camera drawn at
+/// the state tracked for it ([`draw_overlay`]) into `overlay_dir/camN/NNNNNN.png` (a writer
+/// thread encodes them while the next frame is tracked; tracker time excludes both).
+pub fn track_sequence_with(
+    seq: &Path,
+    out_csv: &Path,
+    config: TrackerConfig,
+    progress: bool,
+    overlay_dir: Option<&Path>,
+) -> Result<TrackSummary> {
     let start = Instant::now();
     let sequence = Sequence::open(seq)?;
     sequence.check_frames()?;
     let mut tracker = sequence_tracker(&sequence, config)
         .map_err(|e| anyhow!("{}: cannot start the tracker: {e}", seq.display()))?;
     let mut writer = StatesWriter::create(out_csv, sequence.n_states())?;
+    let mut overlays = overlay_dir.map(|_| PngWriter::start(8)).transpose()?;
     let bar = crate::progress::bar(sequence.frames, "track", progress);
     let mut tracking = Duration::ZERO;
     let (mut lost, mut rms_sum) = (0, 0.0);
@@ -128,12 +157,29 @@ pub fn track_sequence(
         writer
             .write(tracker.state(), &report)
             .with_context(|| format!("frame {k}"))?;
+        if let (Some(dir), Some(writer)) = (overlay_dir, overlays.as_mut()) {
+            for (c, image) in images.iter().enumerate() {
+                let drawn = draw_overlay(
+                    tracker.model(),
+                    &sequence.cameras[c],
+                    tracker.state(),
+                    image,
+                    &config.features,
+                )
+                .with_context(|| format!("{}", sequence.frame_path(c, k).display()))?;
+                writer.write(overlay_path(dir, c, k), drawn)?;
+            }
+        }
         lost += usize::from(report.lost);
         rms_sum += f64::from(report.rms_px);
         bar.inc(1);
     }
     bar.finish_and_clear();
     let frames = writer.finish()?;
+    let overlays = match (overlay_dir, overlays) {
+        (Some(dir), Some(writer)) => Some((dir.to_path_buf(), writer.finish()?)),
+        _ => None,
+    };
     Ok(TrackSummary {
         frames,
         cameras: sequence.cameras.len(),
@@ -143,5 +189,6 @@ pub fn track_sequence(
         total_seconds: start.elapsed().as_secs_f64(),
         out: out_csv.to_path_buf(),
         fps: sequence.fps(),
+        overlays,
     })
 }
