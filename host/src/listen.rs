@@ -1,18 +1,20 @@
-//! `digiteyes listen`: decode what a board sends, print it, and forward it as JSON lines over
-//! UDP to the machine that shows the hand (as DigitEyes sent its states on over TCP).
+//! `digiteyes listen`: decode what a board sends, print it, and forward it to the machines
+//! that show the hand (as DigitEyes sent its states on over TCP).
 //!
 //! Each message is one line: human-readable by default, or its JSON form (serde's
 //! externally tagged form of `BoardMessage`, e.g. `{"State":{"frame":12,"q":[…],…}}`).
-//! Forwarding sends every JSON line (with its newline) as one UDP datagram.
+//! Forwarding ([`crate::forward`]) sends every JSON line (with its newline) as one UDP
+//! datagram, or Open Sound Control packets; only forwarded states are smoothed.
 
 use std::io::Write;
-use std::net::{SocketAddr, ToSocketAddrs, UdpSocket};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use anyhow::{anyhow, bail, Context, Result};
-use digiteyes_core::protocol::{BoardMessage, LinkCounters};
+use anyhow::Result;
+use digiteyes_core::protocol::{BoardMessage, Hello, LinkCounters};
 
+use crate::forward::one_euro::Smoothing;
+use crate::forward::{Forward, ForwardOptions, Forwarder};
 use crate::link::{DropCause, Link, Session, SessionSetup};
 use crate::sequence::{Sequence, SEQUENCE_JSON};
 
@@ -22,8 +24,10 @@ use crate::sequence::{Sequence, SEQUENCE_JSON};
 pub struct ListenOptions {
     /// Print JSON lines instead of text.
     pub json: bool,
-    /// Forward JSON lines to this UDP address.
-    pub forward: Option<SocketAddr>,
+    /// Forward to each of these (JSON lines or OSC over UDP).
+    pub forward: Vec<Forward>,
+    /// Smooth forwarded states with the one-euro filter (`None`: forward them raw).
+    pub smoothing: Option<Smoothing>,
     /// Stop after this many `State`s.
     pub states: Option<usize>,
     /// Stop after this long.
@@ -42,42 +46,34 @@ pub struct ListenSummary {
     pub messages: usize,
     /// `State`s among them.
     pub states: usize,
-    /// Datagrams forwarded.
+    /// Datagrams forwarded (to all targets).
     pub forwarded: usize,
     /// The host receiver's counters.
     pub link: LinkCounters,
 }
 
-/// Parses `udp://HOST:PORT`.
-pub fn parse_forward(url: &str) -> Result<SocketAddr> {
-    let Some(rest) = url.strip_prefix("udp://") else {
-        bail!("--forward `{url}`: expected udp://HOST:PORT");
-    };
-    rest.to_socket_addrs()
-        .with_context(|| format!("--forward `{url}`: cannot resolve {rest}"))?
-        .next()
-        .ok_or_else(|| anyhow!("--forward `{url}`: {rest} resolves to no address"))
-}
-
 /// Listens on `link`, writing a line per message to `out`, until the options' limits (or
 /// forever).
 pub fn listen(link: Link, options: &ListenOptions, out: &mut dyn Write) -> Result<ListenSummary> {
-    let mut link = match &options.setup {
-        Some(path) => set_up(link, path, options.camera_index, out)?,
-        None => link,
-    };
-    let socket = match options.forward {
-        Some(to) => {
-            let local: SocketAddr = if to.is_ipv4() {
-                ([0, 0, 0, 0], 0).into()
-            } else {
-                (std::net::Ipv6Addr::UNSPECIFIED, 0).into()
+    let mut forwarder = match options.forward.is_empty() {
+        true => None,
+        false => {
+            let forward = ForwardOptions {
+                smoothing: options.smoothing,
+                ..ForwardOptions::default()
             };
-            let socket =
-                UdpSocket::bind(local).context("cannot open a UDP socket for --forward")?;
-            Some((socket, to))
+            Some(Forwarder::new(&options.forward, forward)?)
         }
-        None => None,
+    };
+    let mut link = match &options.setup {
+        Some(path) => {
+            let (link, hello, initial_state) = set_up(link, path, options.camera_index, out)?;
+            if let Some(forwarder) = &mut forwarder {
+                forwarder.set_up(&hello, &initial_state);
+            }
+            link
+        }
+        None => link,
     };
     let until = options.duration.map(|d| Instant::now() + d);
     let mut summary = ListenSummary::default();
@@ -94,34 +90,31 @@ pub fn listen(link: Link, options: &ListenOptions, out: &mut dyn Write) -> Resul
         let Some(message) = link.recv(wait.min(Duration::from_millis(200)))? else {
             continue;
         };
+        let received = Instant::now();
         summary.messages += 1;
         summary.states += usize::from(matches!(message, BoardMessage::State(_)));
-        let json = serde_json::to_string(&message)?;
         if options.json {
-            writeln!(out, "{json}")?;
+            writeln!(out, "{}", serde_json::to_string(&message)?)?;
         } else {
             writeln!(out, "{}", describe(&message))?;
         }
         out.flush()?;
-        if let Some((socket, to)) = &socket {
-            let line = format!("{json}\n");
-            socket
-                .send_to(line.as_bytes(), to)
-                .with_context(|| format!("cannot forward to udp://{to}"))?;
-            summary.forwarded += 1;
+        if let Some(forwarder) = &mut forwarder {
+            summary.forwarded += forwarder.send(&message, received)?;
         }
     }
     summary.link = link.counters();
     Ok(summary)
 }
 
-/// Configures and resets the board from a sequence description, then hands the link back.
+/// Configures and resets the board from a sequence description, then hands the link back
+/// with the board's Hello and the initial state it was reset to.
 fn set_up(
     link: Link,
     path: &std::path::Path,
     camera: Option<usize>,
     out: &mut dyn Write,
-) -> Result<Link> {
+) -> Result<(Link, Hello, Vec<f32>)> {
     let json = if path.is_dir() {
         path.join(SEQUENCE_JSON)
     } else {
@@ -129,6 +122,7 @@ fn set_up(
     };
     let sequence = Sequence::open_description(&json)?;
     let setup = SessionSetup::from_sequence(&sequence, camera)?;
+    let initial_state = setup.initial_state.clone();
     let session = Session::start(link, setup)?;
     writeln!(
         out,
@@ -136,7 +130,8 @@ fn set_up(
         session.hello().board,
         json.display()
     )?;
-    Ok(session.into_link())
+    let hello = session.hello().clone();
+    Ok((session.into_link(), hello, initial_state))
 }
 
 /// One line of text for a message.
@@ -193,15 +188,98 @@ pub fn describe(message: &BoardMessage) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use digiteyes_core::protocol::{encode, State, MAX_MESSAGE};
+    use serialport::{SerialPort, TTYPort};
+    use std::net::UdpSocket;
 
+    /// A board on a PTY sends two states; listen prints them raw and forwards them smoothed,
+    /// as JSON lines and as OSC, at once.
     #[test]
-    fn forward_urls() {
-        assert_eq!(
-            parse_forward("udp://127.0.0.1:9000").unwrap(),
-            "127.0.0.1:9000".parse().unwrap()
+    fn prints_raw_and_forwards_smoothed_json_and_osc() {
+        let (mut board, slave) = TTYPort::pair().unwrap();
+        let link = Link::open(&slave.name().unwrap(), 115_200).unwrap();
+        let receiver = || {
+            let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
+            socket
+                .set_read_timeout(Some(Duration::from_secs(10)))
+                .unwrap();
+            socket
+        };
+        let (json_rx, osc_rx) = (receiver(), receiver());
+        let rest: Vec<f32> = crate::scenarios::scenario("mouse")
+            .unwrap()
+            .base
+            .iter()
+            .map(|&v| v as f32)
+            .collect();
+        let mut bytes = Vec::new();
+        for (frame, x) in [(7, 1.5), (9, 101.5)] {
+            let mut q = rest.clone();
+            q[4] = x;
+            let message = BoardMessage::State(State {
+                frame,
+                timestamp: 1000 * u64::from(frame),
+                q: q.into_iter().collect(),
+                rms_px: 0.5,
+                lost: false,
+                features_found: 20,
+                features_expected: 24,
+                iterations: 5,
+                track_ticks: 1234,
+            });
+            let mut buf = [0u8; MAX_MESSAGE];
+            bytes.extend_from_slice(encode(&message, &mut buf).unwrap());
+        }
+        board.write_all(&bytes).unwrap();
+
+        let options = ListenOptions {
+            json: true,
+            states: Some(2),
+            forward: vec![
+                Forward::Json(json_rx.local_addr().unwrap()),
+                Forward::Osc(osc_rx.local_addr().unwrap()),
+            ],
+            smoothing: Some(Smoothing::default()),
+            ..ListenOptions::default()
+        };
+        let mut out = Vec::new();
+        let summary = listen(link, &options, &mut out).unwrap();
+        assert_eq!((summary.states, summary.forwarded), (2, 4));
+
+        let printed: Vec<serde_json::Value> = std::str::from_utf8(&out)
+            .unwrap()
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        assert_eq!(printed[1]["State"]["q"][4], 101.5, "printed raw");
+        let mut buf = [0u8; 65_536];
+        let mut forwarded_x = Vec::new();
+        for _ in 0..2 {
+            let n = json_rx.recv(&mut buf).unwrap();
+            let line: serde_json::Value = serde_json::from_slice(&buf[..n]).unwrap();
+            forwarded_x.push(line["State"]["q"][4].as_f64().unwrap());
+        }
+        assert_eq!(forwarded_x[0], 1.5, "the first state passes through");
+        assert!(
+            forwarded_x[1] > 1.5 && forwarded_x[1] < 100.0,
+            "forwarded smoothed: {forwarded_x:?}"
         );
-        let err = format!("{:#}", parse_forward("tcp://127.0.0.1:9000").unwrap_err());
-        assert!(err.contains("udp://HOST:PORT"), "{err}");
-        assert!(parse_forward("udp://127.0.0.1").is_err());
+        for frame in [7, 9] {
+            let n = osc_rx.recv(&mut buf).unwrap();
+            let (_, packet) = rosc::decoder::decode_udp(&buf[..n]).unwrap();
+            let rosc::OscPacket::Bundle(bundle) = packet else {
+                panic!("a State is a bundle");
+            };
+            let addrs: Vec<String> = bundle
+                .content
+                .iter()
+                .filter_map(|p| match p {
+                    rosc::OscPacket::Message(m) => Some(m.addr.clone()),
+                    _ => None,
+                })
+                .collect();
+            assert_eq!(addrs[0], "/digiteyes/state", "frame {frame}");
+            assert_eq!(addrs.last().unwrap(), "/digiteyes/mouse", "frame {frame}");
+        }
     }
 }

@@ -2,6 +2,7 @@
 
 use digiteyes_board_linux::parse_frame_size;
 use std::io::IsTerminal;
+use std::net::SocketAddr;
 use std::ops::Range;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -10,12 +11,17 @@ use std::time::Duration;
 use anyhow::{bail, Result};
 use clap::{Args, Parser, Subcommand};
 use digiteyes_board_linux::SimOptions;
-use digiteyes_host::demo::run_demo;
+use digiteyes_host::demo::{run_demo, serve_demo_ui, DEFAULT_DEMO_DIR, REPORT_HTML};
+use digiteyes_host::forward::one_euro::{self, Smoothing};
+use digiteyes_host::forward::parse_forward;
 use digiteyes_host::link::{reply_timeout, Link};
-use digiteyes_host::listen::{listen, parse_forward, ListenOptions};
+use digiteyes_host::listen::{listen, ListenOptions};
 use digiteyes_host::scenarios::{render_scenario, RenderOptions, DEFAULT_FRAMES, NAMES};
 use digiteyes_host::stream::{stream_camera, DEFAULT_BAUD};
-use digiteyes_host::{evaluate, stream_sequence, track_sequence, StreamOptions, TrackerConfig};
+use digiteyes_host::ui::{run_ui, UiOptions, UiSource, DEFAULT_BIND};
+use digiteyes_host::{
+    evaluate, stream_sequence, track_sequence_with, StreamOptions, TrackerConfig,
+};
 
 /// Model-based 3D hand tracking after DigitEyes (Rehg 1995).
 ///
@@ -83,6 +89,12 @@ enum Command {
     /// rms_px, iterations, features_found, features_expected, lost (0/1). Prints a summary
     /// (frames, lost frames, mean RMS residual, frames/s). Exits non-zero, naming the file or
     /// frame, on bad input or a tracker error.
+    ///
+    /// With --overlay DIR, each frame of each camera is also written as DIR/camN/NNNNNN.png,
+    /// drawn at the state tracked for it, like the IC40's video overlay: the frame dimmed,
+    /// each link's axis (orange) and silhouette lines (cyan), the slices searched (blue;
+    /// purple where masked as hidden), the edge points found (red squares) and the
+    /// fingertips found (green crosses). See docs/overlay.md.
     Track {
         /// Sequence folder.
         seqdir: PathBuf,
@@ -98,6 +110,9 @@ enum Command {
         /// No progress bar.
         #[arg(long, short)]
         quiet: bool,
+        /// Also draw every frame at its tracked state into DIR/camN/NNNNNN.png.
+        #[arg(long, value_name = "DIR")]
+        overlay: Option<PathBuf>,
     },
     /// Compare estimated states with a sequence's truth.csv.
     ///
@@ -114,6 +129,39 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Write an HTML report of a tracking run: states against time, errors, overlays.
+    ///
+    /// One self-contained page (inline SVG plots and PNG thumbnails, no script, no external
+    /// link: it opens offline and can be mailed alone). It shows the sequence (folder, frames,
+    /// cameras, fps, model, free states); the accuracy against truth.csv when the sequence
+    /// has one (as `eval` prints it); the error over time (mean fingertip reprojection error
+    /// in px and free-joint RMS error in deg against the truth, and the tracker's rms_px
+    /// residual); one plot per free state against time (s; frames without fps) in the
+    /// state's unit (mm, rad), estimate and truth, with the frames flagged lost shaded and
+    /// the frames a board dropped (the `dropped` column of `stream`) marked; and the model
+    /// drawn over every Nth frame (--thumb-every). States that are not numbers are gaps in
+    /// the plots and a warning, not an error. Prints the path written and a summary.
+    Report {
+        /// Sequence folder.
+        seqdir: PathBuf,
+        /// Estimated states (the output of `track` or `stream`).
+        states: PathBuf,
+        /// Output HTML path.
+        #[arg(long, short, default_value = "report.html")]
+        out: PathBuf,
+        /// An overlay thumbnail of frames 0, N, 2N, ... (0: none).
+        #[arg(long, value_name = "N",
+              default_value_t = digiteyes_host::report::DEFAULT_THUMB_EVERY)]
+        thumb_every: usize,
+        /// Thumbnail width in px (the height keeps the camera's aspect).
+        #[arg(long, value_name = "PX",
+              default_value_t = digiteyes_host::report::DEFAULT_THUMB_WIDTH,
+              value_parser = clap::value_parser!(u32).range(16..=4096))]
+        thumb_width: u32,
+        /// Thumbnails of this camera only (0-based; default: every camera).
+        #[arg(long, value_name = "N")]
+        camera_index: Option<usize>,
+    },
     /// Run a simulated digiteyes board on a pseudo-terminal; prints the device to connect to.
     ///
     /// The board is the firmware's loop (the same code as on a Linux board or a
@@ -121,6 +169,11 @@ enum Command {
     /// stream --port` or `digiteyes listen --port` to the printed /dev/pts/N. It tracks the
     /// built-in hand model (or any sub-model of it, such as the mouse scenarios'). Runs until
     /// interrupted (Ctrl-C).
+    ///
+    /// With --overlay DIR, every frame the board tracks is drawn at the state it sent back,
+    /// into DIR/cam0/NNNNNN.png (NNNNNN: the frame number as uploaded), with the colours of
+    /// `track --overlay` (docs/overlay.md). The PNGs are written on a thread of their own; if
+    /// it falls 32 frames behind, the board waits for it.
     Sim {
         /// Flip one random bit in this fraction of the bytes crossing the line, both ways
         /// (0.01 = 1%): line noise, to see the link recover.
@@ -143,6 +196,9 @@ enum Command {
         /// Print the line's byte and error counts every this many seconds (0: never).
         #[arg(long, value_name = "S", default_value_t = 0.0)]
         report_every: f64,
+        /// Draw every tracked frame at its state into DIR/cam0/NNNNNN.png.
+        #[arg(long, value_name = "DIR")]
+        overlay: Option<PathBuf>,
     },
     /// Stream frames to a board over a serial link and write the states it sends back.
     ///
@@ -193,18 +249,47 @@ enum Command {
     ///
     /// Decodes every message on the serial port and prints one line each: text by default,
     /// JSON with --json (e.g. {"State":{"frame":12,"timestamp":…,"q":[…],"rms_px":…,…}}).
-    /// With --forward, every message also goes as one JSON line per UDP datagram to the
-    /// machine that shows the hand. Runs until interrupted, or --states/--seconds. A board
-    /// with its own camera needs setting up first: --setup.
+    /// With --forward, messages also go to the machines that show the hand, as JSON lines
+    /// (udp://) or Open Sound Control (osc://: /digiteyes/state, /digiteyes/q/N,
+    /// /digiteyes/mouse, /digiteyes/dropped, /digiteyes/stats; see docs/forwarding.md).
+    /// With --smooth, forwarded states pass through a one-euro filter (what is printed stays
+    /// raw). Runs until interrupted, or --states/--seconds. A board with its own camera needs
+    /// setting up first: --setup.
     Listen {
         #[command(flatten)]
         port: PortArgs,
         /// Print JSON lines instead of text.
         #[arg(long)]
         json: bool,
-        /// Send every message as a JSON line to this UDP address, e.g. udp://192.168.1.20:5005.
-        #[arg(long, value_name = "udp://HOST:PORT")]
-        forward: Option<String>,
+        /// Forward to this address; may be given several times. udp://HOST:PORT sends every
+        /// message as one JSON line per datagram (e.g. udp://192.168.1.20:5005);
+        /// osc://HOST:PORT sends states (one OSC bundle each, with the 3D mouse for the
+        /// built-in hand: its buttons rest at --setup's initial state, else at the first
+        /// state), drops and counters as Open Sound Control.
+        #[arg(long, value_name = "udp://HOST:PORT|osc://HOST:PORT")]
+        forward: Vec<String>,
+        /// Smooth forwarded states with the one-euro filter (Casiez et al. 2012), timed by
+        /// the board's clock once its Hello is known (--setup, or a board booting while
+        /// listened to), else by the host's receive time. Quaternions are renormalised.
+        #[arg(long, requires = "forward")]
+        smooth: bool,
+        /// With --smooth: the lowest cutoff, at rest (Hz); lower = less jitter, more lag.
+        #[arg(long, value_name = "HZ", requires = "smooth",
+              default_value_t = one_euro::DEFAULT_MIN_CUTOFF_HZ)]
+        min_cutoff: f32,
+        /// With --smooth: cutoff added per mm/s of the palm's translation (q4..q6); higher =
+        /// less lag in fast motion.
+        #[arg(long, value_name = "PER_MM", requires = "smooth",
+              default_value_t = one_euro::DEFAULT_BETA_MM)]
+        beta: f32,
+        /// With --smooth: cutoff added per rad/s of the quaternion and the joints.
+        #[arg(long, value_name = "PER_RAD", requires = "smooth",
+              default_value_t = one_euro::DEFAULT_BETA_RAD)]
+        beta_rad: f32,
+        /// With --smooth: the cutoff of the speed estimate (Hz).
+        #[arg(long, value_name = "HZ", requires = "smooth",
+              default_value_t = one_euro::DEFAULT_D_CUTOFF_HZ)]
+        d_cutoff: f32,
         /// Set the board up first (Configure + Reset) from this sequence.json or sequence
         /// folder: camera calibration, initial state, free states.
         #[arg(long, value_name = "PATH")]
@@ -219,19 +304,78 @@ enum Command {
         #[arg(long, value_name = "S")]
         seconds: Option<f64>,
     },
-    /// Render the `mouse` scenario, stream it to a simulated board, and evaluate.
+    /// Show the hand live in a web page: 3D hand, camera overlay, 3D mouse, link figures.
+    ///
+    /// Serves one page on this machine (default http://127.0.0.1:7878/; every asset is in
+    /// the binary, nothing is fetched from the internet) and feeds it from one source:
+    ///   --port TTY        a board on a serial port (as `listen` reads it; --setup sets it up)
+    ///   --udp ADDR:PORT   JSON lines of board messages, as `listen --forward udp://` sends
+    ///   --replay SEQDIR   a tracked sequence played back at its frame rate, with its frames
+    ///                     and the model drawn over them (states from --states, default
+    ///                     SEQDIR/states.csv)
+    /// The page shows the 3D hand at the newest state (drag to orbit, wheel to zoom), the
+    /// camera frame with the back-projected model when the source has frames, the 3D mouse
+    /// (thesis Sec. 4.3.4: the pole's base follows the palm on the table, its height finger
+    /// 1's fingertip, finger 4 and thumb abduction are two buttons), every state's value,
+    /// states/s, drops, CRC and framing errors, and a lost-track / no-signal badge. Runs
+    /// until interrupted (Ctrl-C) or --seconds.
+    #[command(verbatim_doc_comment)]
+    #[command(group = clap::ArgGroup::new("source").required(true).args(["port", "udp", "replay"]))]
+    Ui {
+        /// The board's serial device (/dev/ttyUSB0, or the /dev/pts/N of `digiteyes sim`).
+        #[arg(long, value_name = "TTY")]
+        port: Option<String>,
+        /// With --port: line speed in bits/s.
+        #[arg(long, value_name = "B", default_value_t = DEFAULT_BAUD, requires = "port")]
+        baud: u32,
+        /// With --port: set the board up first (Configure + Reset) from this sequence.json or
+        /// sequence folder.
+        #[arg(long, value_name = "PATH", requires = "port")]
+        setup: Option<PathBuf>,
+        /// Receive board messages as JSON lines on this UDP address (port 0: any free port).
+        #[arg(long, value_name = "ADDR:PORT")]
+        udp: Option<SocketAddr>,
+        /// Play back this tracked sequence folder.
+        #[arg(long, value_name = "SEQDIR")]
+        replay: Option<PathBuf>,
+        /// With --replay: the states to show (default SEQDIR/states.csv).
+        #[arg(long, value_name = "CSV", requires = "replay")]
+        states: Option<PathBuf>,
+        /// With --replay: frames/s (default: the sequence's, else 15).
+        #[arg(long, value_name = "FPS", requires = "replay")]
+        fps: Option<f64>,
+        /// The camera of a multi-camera sequence (0-based; --replay and --setup).
+        #[arg(long, value_name = "N")]
+        camera_index: Option<usize>,
+        /// Where to serve the page (port 0: any free port). Keep it on loopback unless you
+        /// mean to show the hand to your network.
+        #[arg(long, value_name = "ADDR:PORT", default_value = DEFAULT_BIND)]
+        bind: SocketAddr,
+        /// Stop after this many seconds.
+        #[arg(long, value_name = "S")]
+        seconds: Option<f64>,
+    },
+    /// Render the `mouse` scenario, stream it to a simulated board, evaluate, report, show.
     ///
     /// The rendered camera's frames go to a simulated Linux board (the firmware loop on a
     /// pseudo-terminal, as `digiteyes sim` runs it) over a real serial link; the states it
     /// sends back are evaluated against the ground truth. Prints the accuracy and the link's
-    /// figures.
+    /// figures, writes the HTML report (DIR/report.html), and ends by saying where to open it
+    /// and the UI. In a terminal it then serves the UI (a replay of the run: 3D hand, camera
+    /// overlay, 3D mouse, link figures) until Ctrl-C; otherwise it prints the
+    /// `digiteyes ui --replay` command that shows it.
     Demo {
         /// Number of frames.
         #[arg(long, default_value_t = DEFAULT_FRAMES)]
         frames: usize,
-        /// Keep the sequence (and states.csv) in this folder instead of a temporary one.
-        #[arg(long, value_name = "DIR")]
-        keep: Option<PathBuf>,
+        /// Folder for the run: the sequence, states.csv and report.html (created if
+        /// missing; its files are overwritten).
+        #[arg(long, visible_alias = "keep", value_name = "DIR", default_value = DEFAULT_DEMO_DIR)]
+        out: PathBuf,
+        /// Serve the UI for this many seconds after the run (0: not at all). Default: until
+        /// Ctrl-C when run in a terminal, not at all otherwise.
+        #[arg(long, value_name = "S")]
+        ui_seconds: Option<f64>,
     },
 }
 
@@ -299,9 +443,16 @@ fn run(cli: Cli) -> Result<()> {
             iterations,
             no_predict,
             quiet,
+            overlay,
         } => {
             let config = tracker_config(iterations, no_predict);
-            let summary = track_sequence(&seqdir, &out, config, progress && !quiet)?;
+            let summary = track_sequence_with(
+                &seqdir,
+                &out,
+                config,
+                progress && !quiet,
+                overlay.as_deref(),
+            )?;
             println!("{summary}");
         }
         Command::Eval {
@@ -316,6 +467,24 @@ fn run(cli: Cli) -> Result<()> {
                 print!("{report}");
             }
         }
+        Command::Report {
+            seqdir,
+            states,
+            out,
+            thumb_every,
+            thumb_width,
+            camera_index,
+        } => {
+            let mut options = digiteyes_host::report::ReportOptions::default();
+            options.thumb_every = thumb_every;
+            options.thumb_width = thumb_width;
+            options.camera = camera_index;
+            let summary = digiteyes_host::report::write_report(&seqdir, &states, &out, &options)?;
+            for warning in &summary.warnings {
+                eprintln!("digiteyes: warning: {warning}");
+            }
+            println!("{summary}");
+        }
         Command::Sim {
             corrupt,
             corrupt_frames,
@@ -323,6 +492,7 @@ fn run(cli: Cli) -> Result<()> {
             restart_after,
             max_frame,
             report_every,
+            overlay,
         } => {
             let mut options = SimOptions::default()
                 .frame_buffer_bytes(max_frame.0 as usize * max_frame.1 as usize);
@@ -336,6 +506,16 @@ fn run(cli: Cli) -> Result<()> {
             if let Some(n) = restart_after {
                 options = options.restart_after(n);
             }
+            // The writer runs until the process is interrupted, like the board.
+            let _overlays = match &overlay {
+                Some(dir) => {
+                    let (tap, writer) = digiteyes_host::sim::overlay_tap(dir)?;
+                    options = options.frame_tap(tap);
+                    println!("overlays of the tracked frames go to {}", dir.display());
+                    Some(writer)
+                }
+                None => None,
+            };
             let board = digiteyes_host::sim::start(options)?;
             println!("simulated board on {}", board.path().display());
             println!(
@@ -374,6 +554,11 @@ fn run(cli: Cli) -> Result<()> {
             port,
             json,
             forward,
+            smooth,
+            min_cutoff,
+            beta,
+            beta_rad,
+            d_cutoff,
             setup,
             camera_index,
             states,
@@ -381,7 +566,14 @@ fn run(cli: Cli) -> Result<()> {
         } => {
             let mut options = ListenOptions::default();
             options.json = json;
-            options.forward = forward.as_deref().map(parse_forward).transpose()?;
+            options.forward = forward
+                .iter()
+                .map(|url| parse_forward(url))
+                .collect::<Result<_>>()?;
+            options.smoothing = match smooth {
+                true => Some(Smoothing::new(min_cutoff, beta, beta_rad, d_cutoff)?),
+                false => None,
+            };
             options.setup = setup;
             options.camera_index = camera_index;
             options.states = states;
@@ -401,15 +593,71 @@ fn run(cli: Cli) -> Result<()> {
                 summary.link.framing_errors
             );
         }
-        Command::Demo { frames, keep } => {
-            let result = run_demo(frames, keep.as_deref(), TrackerConfig::default(), progress)?;
+        Command::Ui {
+            port,
+            baud,
+            setup,
+            udp,
+            replay,
+            states,
+            fps,
+            camera_index,
+            bind,
+            seconds,
+        } => {
+            let source = match (port, udp, replay) {
+                (Some(port), None, None) => UiSource::Serial {
+                    port,
+                    baud,
+                    setup,
+                    camera_index,
+                },
+                (None, Some(addr), None) => UiSource::Udp(addr),
+                (None, None, Some(seqdir)) => UiSource::Replay {
+                    states: states.unwrap_or_else(|| seqdir.join("states.csv")),
+                    seqdir,
+                    camera: camera_index.unwrap_or(0),
+                    fps,
+                },
+                _ => bail!("give one of --port TTY, --udp ADDR:PORT or --replay SEQDIR"),
+            };
+            let options = UiOptions {
+                bind,
+                source,
+                duration: seconds.map(reply_timeout).transpose()?,
+            };
+            run_ui(&options, &mut std::io::stdout())?;
+        }
+        Command::Demo {
+            frames,
+            out,
+            ui_seconds,
+        } => {
+            let result = run_demo(frames, &out, TrackerConfig::default(), progress)?;
             println!("{}", result.stream);
             println!("{}", result.board);
             print!("{}", result.eval);
-            match keep {
-                Some(_) => println!("sequence kept in {}", result.sequence.display()),
+            let dir = std::path::absolute(&result.sequence).unwrap_or(result.sequence);
+            println!("run kept in {}", dir.display());
+            println!();
+            println!("report: {}", dir.join(REPORT_HTML).display());
+            let interactive = std::io::stdin().is_terminal() && std::io::stdout().is_terminal();
+            let serve = match ui_seconds {
+                Some(s) if s > 0.0 => Some(Some(reply_timeout(s)?)),
+                Some(_) => None,
+                None if interactive => Some(None),
+                None => None,
+            };
+            match serve {
+                Some(duration) => {
+                    if duration.is_none() {
+                        println!("(serving the UI, a replay of this run; Ctrl-C stops it)");
+                    }
+                    serve_demo_ui(&dir, duration, &mut std::io::stdout())?;
+                }
                 None => println!(
-                    "(the sequence was in a temporary folder, now removed; --keep DIR keeps it)"
+                    "UI: digiteyes ui --replay {}   then open http://{DEFAULT_BIND}/",
+                    dir.display()
                 ),
             }
         }
