@@ -18,7 +18,8 @@ use digiteyes_host::link::{reply_timeout, Link};
 use digiteyes_host::listen::{listen, ListenOptions};
 use digiteyes_host::scenarios::{render_scenario, RenderOptions, DEFAULT_FRAMES, NAMES};
 use digiteyes_host::stream::{stream_camera, DEFAULT_BAUD};
-use digiteyes_host::ui::{run_ui, UiOptions, UiSource, DEFAULT_BIND};
+use digiteyes_host::ui::board_tap::ui_tap;
+use digiteyes_host::ui::{attach_mouse, run_ui, Hub, UiOptions, UiServer, UiSource, DEFAULT_BIND};
 use digiteyes_host::{
     evaluate, stream_sequence, track_sequence_with, StreamOptions, TrackerConfig,
 };
@@ -174,6 +175,10 @@ enum Command {
     /// into DIR/cam0/NNNNNN.png (NNNNNN: the frame number as uploaded), with the colours of
     /// `track --overlay` (docs/overlay.md). The PNGs are written on a thread of their own; if
     /// it falls 32 frames behind, the board waits for it.
+    ///
+    /// With --ui, this process also serves the UI page (docs/ui.md): the newest frame the
+    /// board tracked with the model drawn over it, the 3D hand, the 3D mouse. The board never
+    /// waits for the page; frames it was too slow for are counted as skipped.
     Sim {
         /// Flip one random bit in this fraction of the bytes crossing the line, both ways
         /// (0.01 = 1%): line noise, to see the link recover.
@@ -199,6 +204,11 @@ enum Command {
         /// Draw every tracked frame at its state into DIR/cam0/NNNNNN.png.
         #[arg(long, value_name = "DIR")]
         overlay: Option<PathBuf>,
+        /// Also serve the UI page (docs/ui.md) on ADDR:PORT (default 127.0.0.1:7878): every
+        /// frame the board tracks with the model drawn over it, the 3D hand, the 3D mouse.
+        #[arg(long, value_name = "ADDR:PORT", num_args = 0..=1,
+              default_missing_value = DEFAULT_BIND, conflicts_with = "overlay")]
+        ui: Option<SocketAddr>,
     },
     /// Stream frames to a board over a serial link and write the states it sends back.
     ///
@@ -493,6 +503,7 @@ fn run(cli: Cli) -> Result<()> {
             max_frame,
             report_every,
             overlay,
+            ui,
         } => {
             let mut options = SimOptions::default()
                 .frame_buffer_bytes(max_frame.0 as usize * max_frame.1 as usize);
@@ -513,6 +524,21 @@ fn run(cli: Cli) -> Result<()> {
                     options = options.frame_tap(tap);
                     println!("overlays of the tracked frames go to {}", dir.display());
                     Some(writer)
+                }
+                None => None,
+            };
+            // The UI server and its feeding thread live as long as the board.
+            let _ui = match ui {
+                Some(bind) => {
+                    let model = digiteyes_core::model::Model::hand()
+                        .map_err(|e| anyhow::anyhow!("built-in hand model: {e}"))?;
+                    let hub = Hub::new(model, Vec::new(), "simulated board");
+                    attach_mouse(&hub, None);
+                    let (tap, feeder) = ui_tap(std::sync::Arc::clone(&hub))?;
+                    options = options.frame_tap(tap);
+                    let server = UiServer::start(bind, hub)?;
+                    println!("UI: {}", server.url());
+                    Some((server, feeder))
                 }
                 None => None,
             };

@@ -73,6 +73,10 @@ fn every_tracked_frame_is_tapped_with_the_state_streamed_back() {
         assert_eq!(tapped.lost, state.lost);
         assert_eq!(tapped.rms_px.to_bits(), state.rms_px.to_bits());
         assert_eq!(tapped.iterations, state.iterations);
+        assert_eq!(
+            (tapped.features_found, tapped.features_expected),
+            (state.features_found, state.features_expected)
+        );
         assert_eq!(tapped.boot, 0);
         assert_eq!((tapped.width, tapped.height), (320, 240));
         let image = sequence.read_frame(0, k).unwrap();
@@ -134,4 +138,44 @@ fn sim_overlay_writes_every_tracked_frame_as_a_png() {
         let axis = image.pixels().filter(|p| **p == colours::AXIS).count();
         assert!(axis > 20, "{path:?}: {axis} axis pixels");
     }
+}
+
+#[test]
+fn sim_ui_shows_the_last_tracked_frame_and_its_state() {
+    use digiteyes_host::ui::board_tap::ui_tap;
+    use digiteyes_host::ui::Hub;
+
+    let dir = tempfile::tempdir().unwrap();
+    let seq = mouse(dir.path(), 4);
+    let hub = Hub::new(
+        digiteyes_core::model::Model::hand().unwrap(),
+        Vec::new(),
+        "simulated board",
+    );
+    let (tap, feeder) = ui_tap(std::sync::Arc::clone(&hub)).unwrap();
+    let (summary, report) = stream_to_sim(&seq, SimOptions::default().frame_tap(tap));
+    // The board is stopped and its tap dropped: the feeder has handed over all it was given.
+    feeder.join().unwrap();
+    assert_eq!(report.tapped + report.tap_skipped, 4);
+    let snapshot = hub.snapshot();
+    assert_eq!(snapshot.link.states, report.tapped);
+    let Some(FrameOutcome::Tracked(last)) = summary.outcomes.last() else {
+        panic!("the last frame was not tracked");
+    };
+    // The board hands over the newest frames it has room for; the last one always fits once
+    // the feeder has drained the queue, but a busy feeder may have skipped it, so compare
+    // with the frame the page shows, whichever it is.
+    let shown = snapshot.state.expect("a state on the page");
+    let camera_frame = snapshot.camera_frame.expect("a camera frame on the page");
+    assert_eq!(camera_frame, shown.frame);
+    let outcome = &summary.outcomes[shown.frame as usize];
+    let FrameOutcome::Tracked(state) = outcome else {
+        panic!("frame {} not tracked", shown.frame);
+    };
+    assert_eq!(bits(&shown.q), bits(&state.q));
+    assert_eq!(shown.features_found, state.features_found);
+    assert!(shown.frame <= last.frame);
+    let frame = hub.camera_frame().unwrap();
+    assert_eq!(frame.image.dimensions(), (320, 240));
+    assert_eq!(snapshot.shapes.len(), 16);
 }

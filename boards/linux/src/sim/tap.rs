@@ -39,6 +39,10 @@ pub struct SimFrame {
     pub rms_px: f32,
     /// Gauss–Newton iterations run.
     pub iterations: u8,
+    /// Features found in the last iteration.
+    pub features_found: u16,
+    /// Features expected in the last iteration.
+    pub features_expected: u16,
     /// How many times the board had been power-cycled when it tracked this frame.
     pub boot: u32,
 }
@@ -108,6 +112,8 @@ impl FrameTap {
             lost: tracked.report.lost,
             rms_px: tracked.report.rms_px,
             iterations: tracked.report.iterations,
+            features_found: tracked.report.features_found,
+            features_expected: tracked.report.features_expected,
             boot,
         };
         let delivered = loop {
