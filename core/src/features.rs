@@ -170,7 +170,6 @@ pub fn find_valley(profile: &[f32], min_depth: f32) -> Option<Edge> {
 
 /// One silhouette edge point found on a slice.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct EdgePoint {
     /// Where the slice crosses the axis, as a fraction of the axis from `a` to `b`.
     pub s: f32,
@@ -180,6 +179,22 @@ pub struct EdgePoint {
     pub position: Vector2<f32>,
     /// Derivative magnitude at the edge.
     pub strength: f32,
+}
+
+// By hand: nalgebra's vectors do not implement `defmt::Format`.
+#[cfg(feature = "defmt")]
+impl defmt::Format for EdgePoint {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(
+            f,
+            "EdgePoint {{ s: {}, side: {}, position: ({}, {}), strength: {} }}",
+            self.s,
+            self.side,
+            self.position.x,
+            self.position.y,
+            self.strength
+        )
+    }
 }
 
 /// Most edge points one link yields.
