@@ -681,10 +681,15 @@ fn run(cli: Cli) -> Result<()> {
                     }
                     serve_demo_ui(&dir, duration, &mut std::io::stdout())?;
                 }
-                None => println!(
-                    "UI: digiteyes ui --replay {}   then open http://{DEFAULT_BIND}/",
-                    dir.display()
-                ),
+                None => {
+                    // The command as this very binary, so it runs from `cargo run` too.
+                    let exe = std::env::current_exe()
+                        .map_or_else(|_| "digiteyes".into(), |p| p.display().to_string());
+                    println!(
+                        "UI: {exe} ui --replay {}   then open http://{DEFAULT_BIND}/",
+                        dir.display()
+                    );
+                }
             }
         }
     }

@@ -166,7 +166,8 @@ fn demo_renders_tracks_and_evaluates() {
         "{report}"
     );
     assert!(
-        lines[n - 1].starts_with(&format!("UI: digiteyes ui --replay {}", keep.display()))
+        lines[n - 1].starts_with("UI: ")
+            && lines[n - 1].contains(&format!(" ui --replay {}", keep.display()))
             && lines[n - 1].contains("http://127.0.0.1:"),
         "{report}"
     );
