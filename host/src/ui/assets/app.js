@@ -67,12 +67,10 @@ function drawHand() {
   if (!view.target) view.target = palm ? palm.centre.slice() : shapes[0].a.slice();
   const cam = camera(canvas);
   const items = [];
-  let lowest = Infinity;
-  for (const s of shapes) {
-    if (s.kind === "capsule") lowest = Math.min(lowest, s.a[2] - s.r, s.b[2] - s.r);
-    else lowest = Math.min(lowest, s.centre[2] - [0, 1, 2].reduce((z, k) => z + Math.abs(s.axes[k][2] * s.half[k]), 0));
-  }
-  const onTable = lowest > -5;
+  // The table set-ups put the palm above z = 0 (a curled fingertip may dip below it: the
+  // synthetic scenes have no real table); then the table and the mouse's pole are drawn.
+  const onTable = !!palm &&
+    palm.centre[2] - [0, 1, 2].reduce((z, k) => z + Math.abs(palm.axes[k][2] * palm.half[k]), 0) > 0;
   if (onTable) drawGrid(ctx, cam);
   const light = norm([0.3, -0.5, 1]);
   const skin = [228, 180, 150];
