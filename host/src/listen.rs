@@ -11,12 +11,11 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
-use digiteyes_core::protocol::{BoardMessage, Hello, LinkCounters};
+use digiteyes_core::protocol::{BoardMessage, LinkCounters};
 
 use crate::forward::one_euro::Smoothing;
 use crate::forward::{Forward, ForwardOptions, Forwarder};
-use crate::link::{DropCause, Link, Session, SessionSetup};
-use crate::sequence::{Sequence, SEQUENCE_JSON};
+use crate::link::{set_up_board, DropCause, Link};
 
 /// What to listen for and where it goes.
 #[derive(Debug, Clone, Default)]
@@ -67,7 +66,14 @@ pub fn listen(link: Link, options: &ListenOptions, out: &mut dyn Write) -> Resul
     };
     let mut link = match &options.setup {
         Some(path) => {
-            let (link, hello, initial_state) = set_up(link, path, options.camera_index, out)?;
+            let board = set_up_board(link, path, options.camera_index, out)?;
+            let (link, hello) = (board.link, board.hello);
+            let initial_state: Vec<f32> = board
+                .sequence
+                .initial_state
+                .iter()
+                .map(|&v| v as f32)
+                .collect();
             if let Some(forwarder) = &mut forwarder {
                 forwarder.set_up(&hello, &initial_state);
             }
@@ -105,33 +111,6 @@ pub fn listen(link: Link, options: &ListenOptions, out: &mut dyn Write) -> Resul
     }
     summary.link = link.counters();
     Ok(summary)
-}
-
-/// Configures and resets the board from a sequence description, then hands the link back
-/// with the board's Hello and the initial state it was reset to.
-fn set_up(
-    link: Link,
-    path: &std::path::Path,
-    camera: Option<usize>,
-    out: &mut dyn Write,
-) -> Result<(Link, Hello, Vec<f32>)> {
-    let json = if path.is_dir() {
-        path.join(SEQUENCE_JSON)
-    } else {
-        path.to_path_buf()
-    };
-    let sequence = Sequence::open_description(&json)?;
-    let setup = SessionSetup::from_sequence(&sequence, camera)?;
-    let initial_state = setup.initial_state.clone();
-    let session = Session::start(link, setup)?;
-    writeln!(
-        out,
-        "board {} set up from {}",
-        session.hello().board,
-        json.display()
-    )?;
-    let hello = session.hello().clone();
-    Ok((session.into_link(), hello, initial_state))
 }
 
 /// One line of text for a message.

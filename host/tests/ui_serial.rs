@@ -87,3 +87,41 @@ fn a_board_on_a_serial_port_feeds_the_page() {
     assert_eq!(mouse["x_mm"], 14.0);
     ui.stop().unwrap();
 }
+
+#[test]
+fn a_board_with_its_own_camera_is_set_up_from_a_sequence_folder() {
+    use digiteyes_board_linux::SimOptions;
+    use digiteyes_host::link::{set_up_board, Link};
+    use digiteyes_host::scenarios::{render_scenario, RenderOptions};
+
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("mouse");
+    let render = RenderOptions {
+        frames: Some(1),
+        size: Some((160, 120)),
+        supersample: 1,
+        ..RenderOptions::default()
+    };
+    render_scenario("mouse", &seq, &render).unwrap();
+    let board = digiteyes_host::sim::start(SimOptions::default()).unwrap();
+    let port = board.path().display().to_string();
+
+    let mut said = Vec::new();
+    let set_up = set_up_board(Link::open(&port, 115_200).unwrap(), &seq, None, &mut said).unwrap();
+    let said = String::from_utf8(said).unwrap();
+    assert!(said.starts_with("board linux-sim set up from "), "{said}");
+    assert!(said.contains("sequence.json"), "{said}");
+    assert_eq!(set_up.hello.board.as_str(), "linux-sim");
+    assert_eq!(set_up.sequence.free_states(), vec![4, 5, 8, 9, 10, 19, 24]);
+
+    // A folder without a sequence.json is named in the error, and the board is left alone.
+    let empty = dir.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    let err = set_up_board(set_up.link, &empty, None, &mut std::io::sink()).unwrap_err();
+    let err = format!("{err:#}");
+    assert!(
+        err.contains("empty") && err.contains("sequence.json"),
+        "{err}"
+    );
+    board.stop().unwrap();
+}

@@ -5,6 +5,7 @@
 //! - [`Link`]: the serial port, framing and byte counts;
 //! - [`SessionSetup`]: camera, tracker parameters, initial state, free states, model digest;
 //! - [`Session`]: the handshake, one frame at a time, reboots followed, the final ping;
+//! - [`set_up_board`]: Configure + Reset from a description, for a board with its own camera;
 //! - [`FrameOutcome`] / [`DropCause`]: every frame is tracked or dropped with a reason;
 //! - [`LinkReport`]: states/s, bytes, CRC/framing errors on both ends, drops by reason.
 
@@ -17,5 +18,5 @@ mod setup;
 pub use outcome::{DropCause, FrameOutcome};
 pub use port::Link;
 pub use report::LinkReport;
-pub use session::{reply_timeout, Session};
+pub use session::{reply_timeout, set_up_board, Session, SetUpBoard};
 pub use setup::{SessionSetup, DEFAULT_REPLY_TIMEOUT};

@@ -11,6 +11,8 @@
 //!  Ping(t) ─────────────────────────────▶  Stats, Pong(t)
 //! ```
 
+use std::io::Write;
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Result};
@@ -25,6 +27,7 @@ use super::outcome::{DropCause, FrameOutcome};
 use super::port::Link;
 use super::report::LinkReport;
 use super::setup::SessionSetup;
+use crate::sequence::{Sequence, SEQUENCE_JSON};
 
 /// Attempts at a command (`Configure`, `Reset`, `Ping`) before giving up: on a noisy line a
 /// command or its answer may be lost.
@@ -363,4 +366,45 @@ pub fn reply_timeout(seconds: f64) -> Result<Duration> {
         bail!("--reply-timeout must be a positive number of seconds, not {seconds}");
     }
     Ok(Duration::from_secs_f64(seconds))
+}
+
+/// A board set up from a sequence description, with the link handed back for listening.
+#[derive(Debug)]
+pub struct SetUpBoard {
+    /// The link, the board configured and reset.
+    pub link: Link,
+    /// The board's `Hello`.
+    pub hello: Hello,
+    /// The description it was set up from (model, cameras, initial and free states).
+    pub sequence: Sequence,
+}
+
+/// Configures and resets the board on `link` from `path` (a `sequence.json`, or a sequence
+/// folder holding one), for camera `camera` of a multi-camera description; says so on `out`.
+/// For a board with its own camera: `listen --setup`, `ui --port --setup`.
+pub fn set_up_board(
+    link: Link,
+    path: &Path,
+    camera: Option<usize>,
+    out: &mut dyn Write,
+) -> Result<SetUpBoard> {
+    let json = if path.is_dir() {
+        path.join(SEQUENCE_JSON)
+    } else {
+        path.to_path_buf()
+    };
+    let sequence = Sequence::open_description(&json)?;
+    let session = Session::start(link, SessionSetup::from_sequence(&sequence, camera)?)?;
+    writeln!(
+        out,
+        "board {} set up from {}",
+        session.hello().board,
+        json.display()
+    )?;
+    let hello = session.hello().clone();
+    Ok(SetUpBoard {
+        link: session.into_link(),
+        hello,
+        sequence,
+    })
 }

@@ -34,9 +34,9 @@ use digiteyes_core::model::Model;
 pub use hub::Hub;
 pub use server::{UiServer, DEFAULT_BIND};
 
-use crate::link::{Link, Session, SessionSetup};
+use crate::link::{set_up_board, Link};
 use crate::mouse_pole::{MouseConfig, MouseMapper};
-use crate::sequence::{Sequence, SEQUENCE_JSON};
+use crate::sequence::Sequence;
 
 /// Where the UI's states come from.
 #[derive(Debug, Clone)]
@@ -182,28 +182,13 @@ fn start_source(
             let link = Link::open(port, *baud)?;
             let (link, model, free, rest) = match setup {
                 Some(path) => {
-                    let json = if path.is_dir() {
-                        path.join(SEQUENCE_JSON)
-                    } else {
-                        path.clone()
-                    };
-                    let sequence = Sequence::open_description(&json)?;
-                    let session = Session::start(
-                        link,
-                        SessionSetup::from_sequence(&sequence, *camera_index)?,
-                    )?;
-                    writeln!(
-                        out,
-                        "board {} set up from {}",
-                        session.hello().board,
-                        json.display()
-                    )?;
-                    let rest = sequence.initial_state.iter().map(|&v| v as f32).collect();
+                    let board = set_up_board(link, path, *camera_index, out)?;
+                    let rest = board.sequence.initial_state.iter().map(|&v| v as f32);
                     (
-                        session.into_link(),
-                        sequence.model.clone(),
-                        sequence.free_states(),
-                        Some(rest),
+                        board.link,
+                        board.sequence.model.clone(),
+                        board.sequence.free_states(),
+                        Some(rest.collect()),
                     )
                 }
                 None => (
