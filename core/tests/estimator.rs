@@ -7,36 +7,10 @@ use digiteyes_core::features::{axis_frame, EdgePoint, LinkFeatures};
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Model;
 use digiteyes_core::projection::{ProjectedLink, ProjectedModel};
-use nalgebra::{Matrix3, Vector2, Vector3};
+use nalgebra::Vector2;
 
-const H: f32 = std::f32::consts::FRAC_1_SQRT_2;
-
-/// The sample-mouse fixture's camera (~45° above a palm-down hand).
-fn camera() -> Camera {
-    Camera {
-        width: 640,
-        height: 480,
-        fx: 1000.0,
-        fy: 1000.0,
-        cx: 319.5,
-        cy: 239.5,
-        r: Matrix3::new(H, -H, 0.0, -0.5, -0.5, -H, 0.5, 0.5, -H),
-        t: Vector3::new(26.15406, 25.07026, 520.0828),
-    }
-}
-
-/// A palm-down pose with every joint bent a little, so no derivative is degenerate.
-fn pose() -> Vec<f32> {
-    let mut q = vec![0.0f32; 28];
-    q[..7].copy_from_slice(&[0.05, 0.02, 0.9975, -0.07, 3.0, -2.0, 45.0]);
-    for (i, v) in q.iter_mut().enumerate().skip(7) {
-        *v = 0.15 + 0.03 * (i % 5) as f32;
-    }
-    q[24] = -0.15;
-    q[26] = -0.4;
-    q[27] = -0.5;
-    q
-}
+mod common;
+use common::{bent_pose as pose, table_camera as camera};
 
 fn view_at(model: &Model, q: &[f32], camera: &Camera) -> ProjectedModel {
     let poses = Poses::compute(model, q).unwrap();

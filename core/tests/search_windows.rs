@@ -10,33 +10,10 @@ use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Model;
 use digiteyes_core::projection::ProjectedModel;
-use nalgebra::{Matrix3, Vector2, Vector3};
+use nalgebra::Vector2;
 
-const H: f32 = std::f32::consts::FRAC_1_SQRT_2;
-
-/// The sample-mouse fixture's camera (~45° above a palm-down hand).
-fn camera() -> Camera {
-    Camera {
-        width: 640,
-        height: 480,
-        fx: 1000.0,
-        fy: 1000.0,
-        cx: 319.5,
-        cy: 239.5,
-        r: Matrix3::new(H, -H, 0.0, -0.5, -0.5, -H, 0.5, 0.5, -H),
-        t: Vector3::new(26.15406, 25.07026, 520.0828),
-    }
-}
-
-/// A palm-down pose with every joint bent a little.
-fn pose() -> Vec<f32> {
-    let mut q = vec![0.0f32; 28];
-    q[..7].copy_from_slice(&[0.05, 0.02, 0.9975, -0.07, 3.0, -2.0, 45.0]);
-    for (i, v) in q.iter_mut().enumerate().skip(7) {
-        *v = 0.15 + 0.03 * (i % 5) as f32;
-    }
-    q
-}
+mod common;
+use common::{bent_pose as pose, table_camera as camera};
 
 /// A crude frame of `view`: 200 inside any link's projected outline, 40 elsewhere.
 fn paint(view: &ProjectedModel, camera: &Camera) -> Vec<u8> {
