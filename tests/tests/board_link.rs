@@ -2,7 +2,7 @@
 //! equal to the in-process tracker's, a noisy window, a power cycle, a wrong-size frame, and
 //! a missing device. Every wait is on a message or a condition, with a timeout that fails.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
 
 use digiteyes_board_linux::{Corruption, SimBoard, SimOptions, SimReport, Window};
@@ -15,18 +15,8 @@ use digiteyes_host::{
     StreamSummary, TrackerConfig,
 };
 
-/// A short `mouse` sequence at 320×240 (quick to render, upload and track).
-fn mouse(dir: &Path, frames: usize) -> PathBuf {
-    let seq = dir.join("mouse");
-    let options = RenderOptions {
-        frames: Some(frames),
-        size: Some((320, 240)),
-        supersample: 2,
-        ..RenderOptions::default()
-    };
-    render_scenario("mouse", &seq, &options).unwrap();
-    seq
-}
+mod common;
+use common::mouse;
 
 /// Streams `seq` to a simulated board set up with `options`.
 fn stream_to_sim(

@@ -3,7 +3,7 @@
 //! no room for counted, not lost silently; and `sim --overlay`'s PNG writer. Every wait is on
 //! a message, a channel or a thread, never a sleep.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::mpsc::sync_channel;
 use std::time::Duration;
 
@@ -11,22 +11,10 @@ use digiteyes_board_linux::{FrameTap, SimBoard, SimFrame, SimOptions, SimReport,
 use digiteyes_host::link::FrameOutcome;
 use digiteyes_host::overlay::{colours, overlay_path};
 use digiteyes_host::sequence::Sequence;
-use digiteyes_host::{
-    render_scenario, stream_sequence, RenderOptions, StreamOptions, StreamSummary,
-};
+use digiteyes_host::{stream_sequence, StreamOptions, StreamSummary};
 
-/// A short `mouse` sequence at 320×240.
-fn mouse(dir: &Path, frames: usize) -> PathBuf {
-    let seq = dir.join("mouse");
-    let options = RenderOptions {
-        frames: Some(frames),
-        size: Some((320, 240)),
-        supersample: 2,
-        ..RenderOptions::default()
-    };
-    render_scenario("mouse", &seq, &options).unwrap();
-    seq
-}
+mod common;
+use common::mouse;
 
 /// Streams `seq` to a simulated board set up with `options`, then stops the board.
 fn stream_to_sim(seq: &Path, options: SimOptions) -> (StreamSummary, SimReport) {
