@@ -39,7 +39,7 @@ fn side_camera() -> Camera {
 fn fixture_camera() -> (Camera, Vec<f64>) {
     let text = include_str!(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../shared/fixtures/sample-mouse/sequence.json"
+        "/../fixtures/sample-mouse/sequence.json"
     ));
     let json: serde_json::Value = serde_json::from_str(text).unwrap();
     let cam = &json["cameras"][0];

@@ -8,11 +8,11 @@ use digiteyes_core::model::{
 };
 use digiteyes_core::model_writer::write_dh;
 
-/// The project's spec copy of the table (no `limit` rows). In CI the repository is cloned with
-/// `shared/` beside it.
+/// The published table as data (no `limit` rows), kept apart from `models/hand.dh` so the
+/// built-in model is checked against an independent copy (`fixtures/README.md`).
 const SPEC_HAND_DH: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/spec/hand.dh"
+    "/../fixtures/hand-published.dh"
 ));
 
 fn hand() -> Model {

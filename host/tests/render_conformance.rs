@@ -8,7 +8,7 @@ use digiteyes_host::sequence::Sequence;
 
 const FIXTURE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/fixtures/sample-mouse"
+    "/../fixtures/sample-mouse"
 );
 
 /// Intersection over union of two masks.

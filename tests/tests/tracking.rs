@@ -89,10 +89,10 @@ fn clutter_keeps_track() {
 /// tracker follows it to about a pixel.
 #[test]
 fn the_independent_sample_mouse_fixture_tracks_to_a_pixel() {
-    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/fixtures/sample-mouse");
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/sample-mouse");
     if !fixture.exists() {
         panic!(
-            "fixture missing at {}: the repository must be checked out beside shared/",
+            "fixture missing at {}: it ships with the repository (fixtures/sample-mouse)",
             fixture.display()
         );
     }

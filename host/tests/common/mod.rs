@@ -8,7 +8,7 @@ use digiteyes_host::scenarios::{render_scenario, RenderOptions};
 /// The conformance fixture from an independent renderer.
 pub const FIXTURE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/fixtures/sample-mouse"
+    "/../fixtures/sample-mouse"
 );
 
 /// Renders `frames` frames of `scenario` at 160×120 into `dir/name` and returns that folder.
