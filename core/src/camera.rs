@@ -1,4 +1,4 @@
-//! Calibrated pinhole cameras (no lens distortion), as in `sequence-format.md`.
+//! Calibrated pinhole cameras (no lens distortion), as in `docs/sequence-format.md`.
 //!
 //! A world point `p_w` (mm) maps to camera coordinates `p_c = R · p_w + t` (camera z forward,
 //! x right, y down), then to pixels `u = fx · x_c / z_c + cx`, `v = fy · y_c / z_c + cy`.

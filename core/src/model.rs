@@ -1,6 +1,6 @@
 //! The kinematic hand model: the `hand.dh` format parsed into a fixed-capacity tree.
 //!
-//! Format (see `models/hand.dh` and the project's `hand-model.md`): one row per link frame,
+//! Format (see `models/hand.dh` and `docs/hand-model.md`): one row per link frame,
 //!
 //! ```text
 //! frame  name  theta  d  a  alpha  shape  next
@@ -23,7 +23,7 @@ use heapless::{String, Vec};
 use crate::config::{MAX_CHAIN, MAX_CHILDREN, MAX_FRAMES, MAX_NAME_LEN, MAX_STATES};
 
 /// The whole-hand model of the thesis (Table 2.1 / Appendix A) with the corrections of
-/// `hand-model.md` and the joint ranges of the project's test sequences.
+/// `docs/hand-model.md` and the joint ranges of the project's test sequences.
 pub const HAND_DH: &str = include_str!("../../models/hand.dh");
 
 /// States taken by the palm's spatial transform: quaternion `(w, x, y, z)` then translation.

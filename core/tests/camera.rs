@@ -1,4 +1,4 @@
-//! The pinhole camera of `sequence-format.md`: projections worked out by hand, the pixel-centre
+//! The pinhole camera of `docs/sequence-format.md`: projections worked out by hand, the pixel-centre
 //! convention, points that must not project, the projection Jacobian against finite
 //! differences, and `validate`'s error paths.
 

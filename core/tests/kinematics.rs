@@ -1,4 +1,4 @@
-//! Forward kinematics against `hand-model.md`'s geometry, and the analytic point derivatives
+//! Forward kinematics against `docs/hand-model.md`'s geometry, and the analytic point derivatives
 //! (Eq. 2.16 and the quaternion chain rule) against central finite differences.
 
 mod common;
@@ -30,7 +30,7 @@ fn assert_close(a: Vector3<f32>, b: Vector3<f32>, tol: f32, what: &str) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Geometry at all states zero (hand-model.md, "Orientation, at all states zero"). The expected
+// Geometry at all states zero (docs/hand-model.md, "The whole hand"). The expected
 // origins follow from the table by hand: each finger's constant frames move `a` along +y and
 // then `d` along the (world −x) z axis of the second frame, then the link lengths run along +y.
 
@@ -66,7 +66,7 @@ fn finger_and_thumb_origins_at_zero() {
             assert_close(o(base + 5 + j), Vector3::new(x, y, 0.0), 1e-4, "link end");
         }
     }
-    // Finger 1 at x = 31, finger 4 at x = −26 (hand-model.md).
+    // Finger 1 at x = 31, finger 4 at x = −26 (docs/hand-model.md).
     assert!((o(7).x - 31.0).abs() < 1e-4 && (o(28).x + 26.0).abs() < 1e-4);
     // The thumb along +y at x = 38, z = 15: frame 31 at y = −43 (a = 43 along −y), then
     // link0 (46), the opposition frame, link1 (34), link2 (25).

@@ -1,4 +1,4 @@
-//! The `hand.dh` parser and writer: the built-in hand against `hand-model.md`, round trips, and
+//! The `hand.dh` parser and writer: the built-in hand against `docs/hand-model.md`, round trips, and
 //! every error path of `ModelErrorKind` with the line it is reported on.
 
 use digiteyes_core::config::{MAX_CHAIN, MAX_FRAMES, MAX_NAME_LEN, MAX_STATES};
@@ -44,7 +44,7 @@ fn assert_error(text: &str, line: u32, kind: ModelErrorKind) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The built-in whole-hand model against hand-model.md.
+// The built-in whole-hand model against docs/hand-model.md.
 
 #[test]
 fn hand_has_37_frames_and_28_states() {
@@ -56,7 +56,7 @@ fn hand_has_37_frames_and_28_states() {
 
 #[test]
 fn hand_names_sit_on_the_corrected_frames() {
-    // hand-model.md: proximal phalanges on the MCP frames 4, 11, 18, 25 (thumb 32), Thumb Link 1
+    // docs/hand-model.md: proximal phalanges on the MCP frames 4, 11, 18, 25 (thumb 32), Thumb Link 1
     // on frame 34; each finger is link0, link1, link2, tip on consecutive frames.
     let m = hand();
     assert_eq!(m.find("palm"), Some(0));
@@ -91,7 +91,7 @@ fn hand_joint_frames_follow_table_order() {
             assert_eq!(m.joint_frame(7 + 4 * k + j), Some(3 + 7 * k + j));
         }
     }
-    // Thumb q23..q27 (hand-model.md's correction of the repeated q25).
+    // Thumb q23..q27 (docs/hand-model.md's correction of the repeated q25).
     for (s, f) in [(23, 31), (24, 32), (25, 33), (26, 34), (27, 35)] {
         assert_eq!(m.joint_frame(s), Some(f), "q{s}");
         assert_eq!(m.links()[f].theta, Theta::State(s as u8));
@@ -500,7 +500,7 @@ fn state_out_of_order() {
         2,
         StateOutOfOrder { expected: 7 },
     );
-    // The extracted Appendix A's defect: frame 34 repeats q25 (hand-model.md).
+    // The extracted Appendix A's defect: frame 34 repeats q25 (docs/hand-model.md).
     let row34 = SPEC_HAND_DH
         .lines()
         .position(|l| l.starts_with("34 "))

@@ -1,7 +1,7 @@
 //! The host side of digiteyes: sequence I/O, the synthetic renderer, tracking and evaluation
 //! of recorded sequences. The `digiteyes` binary is a thin command-line layer over this crate.
 //!
-//! - [`sequence`]: the on-disk contract of `sequence-format.md` — `sequence.json`, the
+//! - [`sequence`]: the on-disk contract of `docs/sequence-format.md` — `sequence.json`, the
 //!   `camN/NNNNNN.pgm` frames, `truth.csv` and the tracker's output CSV.
 //! - [`render`]: the project's synthetic renderer (ray-cast capsules and the palm box,
 //!   Lambertian shading, supersampled, optional noise, blur and clutter).

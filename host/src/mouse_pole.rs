@@ -190,7 +190,7 @@ mod tests {
     }
 
     /// Finger 1's fingertip in world coordinates (mm), composed in f64 from the DH rows of
-    /// `hand-model.md` written out here, apart from the core's kinematics: the palm's rotation
+    /// `docs/hand-model.md` written out here, apart from the core's kinematics: the palm's rotation
     /// from its quaternion, then rows 1..6 of the table.
     fn finger1_tip_f64(q: &[f32]) -> [f64; 3] {
         type M = [[f64; 4]; 4];
@@ -268,7 +268,7 @@ mod tests {
     #[test]
     fn the_height_is_analytic_for_a_palm_up_hand() {
         // Palm frame = world moved up 50 mm; finger 1 flexes in the palm frame's y-z plane:
-        // its tip is at z = 50 + 45 sin a + 26 sin(a + b) + 24 sin(a + b + c) (hand-model.md:
+        // its tip is at z = 50 + 45 sin a + 26 sin(a + b) + 24 sin(a + b + c) (docs/hand-model.md:
         // rows 1–3 turn the finger's flexion axis to the palm's x axis, 31 mm out, 38 mm up).
         let mut q = vec![0.0f32; 28];
         q[0] = 1.0;

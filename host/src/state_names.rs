@@ -1,6 +1,6 @@
 //! What each of the hand model's 28 states means, for labels in reports, plots and the UI.
 //!
-//! Numbering follows `hand.dh` (see `hand-model.md`): q0..q3 the palm's unit quaternion
+//! Numbering follows `hand.dh` (see `docs/hand-model.md`): q0..q3 the palm's unit quaternion
 //! (w, x, y, z), q4..q6 its translation (mm, world), then four joints per finger (abduction,
 //! MCP, PIP and DIP flexion; rad) and five for the thumb (q23..q27, rad).
 

@@ -4,7 +4,9 @@
 //! a drawn hand.
 //!
 //! Needs Debian's `chromium` (scripts/test installs it; `DIGITEYES_CHROMIUM` names another
-//! binary). Without it each test prints `SKIPPED: ...` to stderr and passes.
+//! binary). Without it each test prints `SKIPPED: ...` to stderr and passes (under `CI=true` it fails).
+
+mod common;
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream, UdpSocket};
@@ -46,11 +48,9 @@ fn chromium() -> Result<PathBuf, String> {
 }
 
 fn skip(test: &str, reason: &str) {
-    // Straight to the process's stderr: the harness captures `eprintln!` of a passing test,
-    // and a skip must be seen.
-    let _ = writeln!(
-        std::io::stderr(),
-        "\nSKIPPED: UI browser test `{test}` (tests/tests/ui_browser.rs): {reason}\n"
+    common::skip(
+        &format!("UI browser test `{test}` (tests/tests/ui_browser.rs)"),
+        reason,
     );
 }
 

@@ -17,3 +17,16 @@ pub fn mouse(dir: &Path, frames: usize) -> PathBuf {
     render_scenario("mouse", &seq, &options).unwrap();
     seq
 }
+
+/// A test that cannot run here (a tool missing). Outside CI it prints `SKIPPED: …` straight to
+/// the process's stderr (the harness captures `eprintln!` of a passing test, and a skip must
+/// be seen) and the test passes. Under CI (`CI=true`, as `.ci/run` is run) a skip is a
+/// failure: CI must never go green on tests that did not run.
+pub fn skip(what: &str, reason: &str) {
+    let message = format!("SKIPPED: {what}: {reason}");
+    if std::env::var("CI").is_ok_and(|v| v == "true" || v == "1") {
+        panic!("{message} (CI=true: a skipped test fails the run; install what it needs)");
+    }
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "\n{message}\n");
+}
