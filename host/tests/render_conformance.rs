@@ -6,10 +6,7 @@ use std::path::Path;
 use digiteyes_host::render::{RenderSettings, Renderer};
 use digiteyes_host::sequence::Sequence;
 
-const FIXTURE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../fixtures/sample-mouse"
-);
+const FIXTURE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../fixtures/sample-mouse");
 
 /// Intersection over union of two masks.
 fn iou(a: &[bool], b: &[bool]) -> f64 {

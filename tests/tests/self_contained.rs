@@ -23,10 +23,14 @@ fn text_files(dir: &Path, out: &mut Vec<PathBuf>) {
             if name != "target" && name != "fixtures" {
                 text_files(&path, out);
             }
-        } else if ["rs", "md", "toml", "sh", "js", "html", "css", "json", "dh", "x"]
-            .iter()
-            .any(|ext| path.extension().is_some_and(|e| e == *ext))
-            || path.parent().is_some_and(|p| p.ends_with("scripts") || p.ends_with(".ci"))
+        } else if [
+            "rs", "md", "toml", "sh", "js", "html", "css", "json", "dh", "x",
+        ]
+        .iter()
+        .any(|ext| path.extension().is_some_and(|e| e == *ext))
+            || path
+                .parent()
+                .is_some_and(|p| p.ends_with("scripts") || p.ends_with(".ci"))
         {
             out.push(path);
         }
@@ -37,20 +41,34 @@ fn text_files(dir: &Path, out: &mut Vec<PathBuf>) {
 fn nothing_reads_or_links_outside_the_repository() {
     let mut files = Vec::new();
     text_files(&root(), &mut files);
-    assert!(files.len() > 50, "found only {} files under {}", files.len(), root().display());
+    assert!(
+        files.len() > 50,
+        "found only {} files under {}",
+        files.len(),
+        root().display()
+    );
     let outside = "../shared/";
     let machine_paths = ["/work/", "/root/", "/home/"];
     let mut offenders = Vec::new();
     // This file names what it looks for.
-    for file in files.iter().filter(|f| !f.ends_with(file!().rsplit('/').next().unwrap())) {
-        let Ok(text) = fs::read_to_string(file) else { continue };
+    for file in files
+        .iter()
+        .filter(|f| !f.ends_with(file!().rsplit('/').next().unwrap()))
+    {
+        let Ok(text) = fs::read_to_string(file) else {
+            continue;
+        };
         for (i, line) in text.lines().enumerate() {
             if line.contains(&outside) || machine_paths.iter().any(|p| line.contains(p)) {
                 offenders.push(format!("{}:{}: {}", file.display(), i + 1, line.trim()));
             }
         }
     }
-    assert!(offenders.is_empty(), "references outside the repository:\n{}", offenders.join("\n"));
+    assert!(
+        offenders.is_empty(),
+        "references outside the repository:\n{}",
+        offenders.join("\n")
+    );
 }
 
 #[test]
@@ -63,7 +81,10 @@ fn the_readmes_local_links_lead_somewhere() {
         if target.starts_with("http") || target.starts_with('#') {
             continue;
         }
-        assert!(root().join(target).exists(), "README links to missing `{target}`");
+        assert!(
+            root().join(target).exists(),
+            "README links to missing `{target}`"
+        );
         checked += 1;
     }
     for word in readme.split(|c: char| c == '`' || c.is_whitespace() || c == '(' || c == ')') {
@@ -73,7 +94,10 @@ fn the_readmes_local_links_lead_somewhere() {
             checked += 1;
         }
     }
-    assert!(checked >= 5, "only {checked} local references found in README.md");
+    assert!(
+        checked >= 5,
+        "only {checked} local references found in README.md"
+    );
 }
 
 #[test]

@@ -6,10 +6,7 @@ use std::path::{Path, PathBuf};
 use digiteyes_host::scenarios::{render_scenario, RenderOptions};
 
 /// The conformance fixture from an independent renderer.
-pub const FIXTURE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../fixtures/sample-mouse"
-);
+pub const FIXTURE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../fixtures/sample-mouse");
 
 /// Renders `frames` frames of `scenario` at 160×120 into `dir/name` and returns that folder.
 pub fn small_sequence(dir: &Path, scenario: &str, frames: usize) -> PathBuf {
