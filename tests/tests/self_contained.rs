@@ -30,7 +30,7 @@ fn text_files(dir: &Path, out: &mut Vec<PathBuf>) {
         .any(|ext| path.extension().is_some_and(|e| e == *ext))
             || path
                 .parent()
-                .is_some_and(|p| p.ends_with("scripts") || p.ends_with(".ci"))
+                .is_some_and(|p| p.file_name().is_some_and(|n| n == "scripts" || n == ".ci"))
         {
             out.push(path);
         }
@@ -59,7 +59,7 @@ fn nothing_reads_or_links_outside_the_repository() {
             continue;
         };
         for (i, line) in text.lines().enumerate() {
-            if line.contains(&outside) || machine_paths.iter().any(|p| line.contains(p)) {
+            if line.contains(outside) || machine_paths.iter().any(|p| line.contains(p)) {
                 offenders.push(format!("{}:{}: {}", file.display(), i + 1, line.trim()));
             }
         }
