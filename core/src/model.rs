@@ -137,6 +137,8 @@ pub enum ModelErrorKind {
     UnknownToken(&'static str),
     /// This field is not a finite number.
     BadNumber(&'static str),
+    /// This length (mm) is a number but not above zero.
+    NotPositive(&'static str),
     /// Tokens left after `next`.
     TrailingTokens,
     /// Frames must be numbered 0, 1, 2, ... in order.
@@ -173,6 +175,11 @@ pub enum ModelErrorKind {
     },
     /// More than [`MAX_FRAMES`] frames.
     TooManyFrames,
+    /// `next` names a frame number at or past [`MAX_FRAMES`]: no model can have it.
+    FrameBeyondLimit {
+        /// The frame named.
+        frame: u16,
+    },
     /// More than [`MAX_STATES`] states.
     TooManyStates,
     /// More than [`MAX_CHILDREN`] frames in one `next`.
@@ -193,6 +200,9 @@ impl fmt::Display for ModelErrorKind {
             Self::MissingField(field) => write!(f, "missing field `{field}`"),
             Self::UnknownToken(field) => write!(f, "unknown token in field `{field}`"),
             Self::BadNumber(field) => write!(f, "field `{field}` is not a finite number"),
+            Self::NotPositive(field) => {
+                write!(f, "field `{field}` must be a length above 0 (mm)")
+            }
             Self::TrailingTokens => write!(f, "unexpected tokens after `next`"),
             Self::FrameOutOfOrder { expected } => {
                 write!(f, "frames out of order: expected frame {expected}")
@@ -207,7 +217,15 @@ impl fmt::Display for ModelErrorKind {
             }
             Self::Cycle { frame } => write!(f, "cycle in `next` through frame {frame}"),
             Self::Unreachable { frame } => write!(f, "frame {frame} is not reached from frame 0"),
-            Self::TooManyFrames => write!(f, "more than {MAX_FRAMES} frames"),
+            Self::TooManyFrames => {
+                write!(f, "more than {MAX_FRAMES} frames (a model has at most {MAX_FRAMES})")
+            }
+            Self::FrameBeyondLimit { frame } => write!(
+                f,
+                "`next` names frame {frame}, but a model has at most {MAX_FRAMES} frames \
+                 (0 to {})",
+                MAX_FRAMES - 1
+            ),
             Self::TooManyStates => write!(f, "more than {MAX_STATES} states"),
             Self::TooManyChildren => write!(f, "more than {MAX_CHILDREN} frames in `next`"),
             Self::ChainTooDeep => write!(f, "more than {MAX_CHAIN} joints in one chain"),
@@ -462,7 +480,7 @@ fn parse_row<'a>(
             .parse()
             .map_err(|_| ModelErrorKind::UnknownToken("next"))?;
         if usize::from(child) >= MAX_FRAMES {
-            return Err(ModelErrorKind::MissingFrame { frame: child });
+            return Err(ModelErrorKind::FrameBeyondLimit { frame: child });
         }
         children
             .push(child as u8)
@@ -563,7 +581,7 @@ fn parse_length(token: &str, field: &'static str) -> Result<f32, ModelErrorKind>
     if v > 0.0 {
         Ok(v)
     } else {
-        Err(ModelErrorKind::BadNumber(field))
+        Err(ModelErrorKind::NotPositive(field))
     }
 }
 

@@ -449,16 +449,25 @@ fn bad_number() {
         2,
         BadNumber("theta"),
     );
-    assert_error("0 palm base 0 0 0 box 1 0 1 -", 1, BadNumber("box y"));
+    assert_error(
+        "0 palm base 0 0 0 box 1 0 1 -",
+        1,
+        ModelErrorKind::NotPositive("box y"),
+    );
     assert_error(
         "0 palm base 0 0 0 - 1\n1 a 0 0 0 0 cyl -2 -",
         2,
-        BadNumber("radius"),
+        ModelErrorKind::NotPositive("radius"),
+    );
+    assert_error(
+        "0 palm base 0 0 0 - 1\n1 a 0 0 0 0 cyl abc -",
+        2,
+        ModelErrorKind::UnknownToken("radius"),
     );
     assert_error(
         "0 palm base 0 0 0 - 1\n1 a 0 0 0 0 tip 0 -",
         2,
-        BadNumber("radius"),
+        ModelErrorKind::NotPositive("radius"),
     );
     assert_error(&format!("{TINY}limit q7 0 1e40"), 4, BadNumber("hi"));
 }
@@ -536,8 +545,12 @@ fn missing_frame_in_next() {
         2,
         MissingFrame { frame: 5 },
     );
-    // Beyond any model's capacity: reported while reading the row.
-    assert_error("0 palm base 0 0 0 - 200", 1, MissingFrame { frame: 200 });
+    // Beyond any model's capacity: reported while reading the row, naming the limit.
+    assert_error(
+        "0 palm base 0 0 0 - 200",
+        1,
+        ModelErrorKind::FrameBeyondLimit { frame: 200 },
+    );
 }
 
 #[test]
@@ -608,9 +621,20 @@ fn too_many_frames() {
         Model::parse(&constant_chain(MAX_FRAMES)).is_ok(),
         "exactly MAX_FRAMES fit"
     );
-    // One row more (unreferenced: naming frame MAX_FRAMES in a `next` is a MissingFrame).
+    // One row more (unreferenced: naming frame MAX_FRAMES in a `next` is FrameBeyondLimit).
     let text = constant_chain(MAX_FRAMES) + &format!("{MAX_FRAMES} extra 0 0 0 0 - -\n");
     assert_error(&text, MAX_FRAMES as u32 + 1, ModelErrorKind::TooManyFrames);
+    // A chain of MAX_FRAMES + 1 frames: its last `next` names frame MAX_FRAMES, and the
+    // message says why that cannot be, not that the frame is missing.
+    let text = constant_chain(MAX_FRAMES + 1);
+    let e = error(&text);
+    assert_eq!(
+        e.kind,
+        ModelErrorKind::FrameBeyondLimit {
+            frame: MAX_FRAMES as u16
+        }
+    );
+    assert!(e.to_string().contains(&format!("at most {MAX_FRAMES} frames")), "{e}");
 }
 
 /// A palm with `n` joint frames q7.. hanging from it in a straight chain.

@@ -30,6 +30,8 @@
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod atomic_file;
+pub mod cli_values;
 pub mod demo;
 pub mod eval;
 pub mod forward;
@@ -45,6 +47,7 @@ pub mod sequence;
 pub mod sim;
 pub mod state_names;
 pub mod stream;
+pub mod text;
 pub mod track;
 pub mod ui;
 

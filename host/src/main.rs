@@ -6,7 +6,6 @@ use std::net::SocketAddr;
 use std::ops::Range;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::Duration;
 
 use anyhow::{bail, Result};
 use clap::{Args, Parser, Subcommand};
@@ -14,7 +13,8 @@ use digiteyes_board_linux::SimOptions;
 use digiteyes_host::demo::{run_demo, serve_demo_ui, DEFAULT_DEMO_DIR, REPORT_HTML};
 use digiteyes_host::forward::one_euro::{self, Smoothing};
 use digiteyes_host::forward::parse_forward;
-use digiteyes_host::link::{reply_timeout, Link};
+use digiteyes_host::cli_values;
+use digiteyes_host::link::Link;
 use digiteyes_host::listen::{listen, ListenOptions};
 use digiteyes_host::scenarios::{render_scenario, RenderOptions, DEFAULT_FRAMES, NAMES};
 use digiteyes_host::stream::{stream_camera, DEFAULT_BAUD};
@@ -26,7 +26,7 @@ use digiteyes_host::{
 
 /// Model-based 3D hand tracking after DigitEyes (Rehg 1995).
 ///
-/// Sequences are folders in the format of `sequence-format.md`: `sequence.json`, frames
+/// Sequences are folders in the format of `docs/sequence-format.md`: `sequence.json`, frames
 /// `camN/NNNNNN.pgm` (8-bit P5) and optionally `truth.csv`. Units: mm, rad, px.
 #[derive(Parser, Debug)]
 #[command(name = "digiteyes", version, about, long_about)]
@@ -63,15 +63,15 @@ enum Command {
         /// Seed of the motion, noise and clutter.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Number of frames.
-        #[arg(long, default_value_t = DEFAULT_FRAMES)]
+        /// Number of frames (1 to 100000).
+        #[arg(long, default_value_t = DEFAULT_FRAMES, value_parser = cli_values::frame_count)]
         frames: usize,
-        /// Gaussian noise standard deviation in grey levels (default: the scenario's, 2; 8 for
-        /// `clutter`).
-        #[arg(long, value_name = "SIGMA")]
+        /// Gaussian noise standard deviation in grey levels, 0 to 128 (default: the
+        /// scenario's, 2; 8 for `clutter`).
+        #[arg(long, value_name = "SIGMA", value_parser = cli_values::noise_sigma)]
         noise: Option<f32>,
-        /// Gaussian blur standard deviation in px (default: the scenario's, 0.5).
-        #[arg(long, value_name = "SIGMA")]
+        /// Gaussian blur standard deviation in px, 0 to 20 (default: the scenario's, 0.5).
+        #[arg(long, value_name = "SIGMA", value_parser = cli_values::blur_sigma)]
         blur: Option<f32>,
         /// Cluttered, textured background (default: only for `clutter`).
         #[arg(long)]
@@ -181,8 +181,8 @@ enum Command {
     /// waits for the page; frames it was too slow for are counted as skipped.
     Sim {
         /// Flip one random bit in this fraction of the bytes crossing the line, both ways
-        /// (0.01 = 1%): line noise, to see the link recover.
-        #[arg(long, value_name = "RATE", default_value_t = 0.0)]
+        /// (0.01 = 1%; 0 to 1): line noise, to see the link recover.
+        #[arg(long, value_name = "RATE", default_value_t = 0.0, value_parser = cli_values::share)]
         corrupt: f64,
         /// Only corrupt while these frames are uploaded (A..B: frames A to B-1).
         #[arg(long, value_name = "A..B", value_parser = digiteyes_host::sim::parse_range,
@@ -198,8 +198,9 @@ enum Command {
         /// The board's frame buffer: the largest frame it accepts, WxH px.
         #[arg(long, value_name = "WxH", value_parser = parse_frame_size, default_value = "640x480")]
         max_frame: (u32, u32),
-        /// Print the line's byte and error counts every this many seconds (0: never).
-        #[arg(long, value_name = "S", default_value_t = 0.0)]
+        /// Print the line's byte and error counts every this many seconds (0: never; at most a
+        /// week).
+        #[arg(long, value_name = "S", default_value_t = 0.0, value_parser = cli_values::seconds_or_zero)]
         report_every: f64,
         /// Draw every tracked frame at its state into DIR/cam0/NNNNNN.png.
         #[arg(long, value_name = "DIR")]
@@ -285,20 +286,20 @@ enum Command {
         smooth: bool,
         /// With --smooth: the lowest cutoff, at rest (Hz); lower = less jitter, more lag.
         #[arg(long, value_name = "HZ", requires = "smooth",
-              default_value_t = one_euro::DEFAULT_MIN_CUTOFF_HZ)]
+              default_value_t = one_euro::DEFAULT_MIN_CUTOFF_HZ, value_parser = cli_values::positive)]
         min_cutoff: f32,
         /// With --smooth: cutoff added per mm/s of the palm's translation (q4..q6); higher =
         /// less lag in fast motion.
         #[arg(long, value_name = "PER_MM", requires = "smooth",
-              default_value_t = one_euro::DEFAULT_BETA_MM)]
+              default_value_t = one_euro::DEFAULT_BETA_MM, value_parser = cli_values::non_negative)]
         beta: f32,
         /// With --smooth: cutoff added per rad/s of the quaternion and the joints.
         #[arg(long, value_name = "PER_RAD", requires = "smooth",
-              default_value_t = one_euro::DEFAULT_BETA_RAD)]
+              default_value_t = one_euro::DEFAULT_BETA_RAD, value_parser = cli_values::non_negative)]
         beta_rad: f32,
         /// With --smooth: the cutoff of the speed estimate (Hz).
         #[arg(long, value_name = "HZ", requires = "smooth",
-              default_value_t = one_euro::DEFAULT_D_CUTOFF_HZ)]
+              default_value_t = one_euro::DEFAULT_D_CUTOFF_HZ, value_parser = cli_values::positive)]
         d_cutoff: f32,
         /// Set the board up first (Configure + Reset) from this sequence.json or sequence
         /// folder: camera calibration, initial state, free states.
@@ -310,8 +311,8 @@ enum Command {
         /// Stop after this many states.
         #[arg(long, value_name = "N")]
         states: Option<usize>,
-        /// Stop after this many seconds.
-        #[arg(long, value_name = "S")]
+        /// Stop after this many seconds (at most a week).
+        #[arg(long, value_name = "S", value_parser = cli_values::positive_seconds)]
         seconds: Option<f64>,
     },
     /// Show the hand live in a web page: 3D hand, camera overlay, 3D mouse, link figures.
@@ -351,8 +352,8 @@ enum Command {
         /// With --replay: the states to show (default SEQDIR/states.csv).
         #[arg(long, value_name = "CSV", requires = "replay")]
         states: Option<PathBuf>,
-        /// With --replay: frames/s (default: the sequence's, else 15).
-        #[arg(long, value_name = "FPS", requires = "replay")]
+        /// With --replay: frames/s, 0.01 to 1000 (default: the sequence's, else 15).
+        #[arg(long, value_name = "FPS", requires = "replay", value_parser = cli_values::fps)]
         fps: Option<f64>,
         /// The camera of a multi-camera sequence (0-based; --replay and --setup).
         #[arg(long, value_name = "N")]
@@ -361,8 +362,8 @@ enum Command {
         /// mean to show the hand to your network.
         #[arg(long, value_name = "ADDR:PORT", default_value = DEFAULT_BIND)]
         bind: SocketAddr,
-        /// Stop after this many seconds.
-        #[arg(long, value_name = "S")]
+        /// Stop after this many seconds (at most a week).
+        #[arg(long, value_name = "S", value_parser = cli_values::positive_seconds)]
         seconds: Option<f64>,
     },
     /// Render the `mouse` scenario, stream it to a simulated board, evaluate, report, show.
@@ -375,16 +376,16 @@ enum Command {
     /// overlay, 3D mouse, link figures) until Ctrl-C; otherwise it prints the
     /// `digiteyes ui --replay` command that shows it.
     Demo {
-        /// Number of frames.
-        #[arg(long, default_value_t = DEFAULT_FRAMES)]
+        /// Number of frames (1 to 100000).
+        #[arg(long, default_value_t = DEFAULT_FRAMES, value_parser = cli_values::frame_count)]
         frames: usize,
         /// Folder for the run: the sequence, states.csv and report.html (created if
         /// missing; its files are overwritten).
         #[arg(long, visible_alias = "keep", value_name = "DIR", default_value = DEFAULT_DEMO_DIR)]
         out: PathBuf,
-        /// Serve the UI for this many seconds after the run (0: not at all). Default: until
-        /// Ctrl-C when run in a terminal, not at all otherwise.
-        #[arg(long, value_name = "S")]
+        /// Serve the UI for this many seconds after the run (0: not at all; at most a week).
+        /// Default: until Ctrl-C when run in a terminal, not at all otherwise.
+        #[arg(long, value_name = "S", value_parser = cli_values::seconds_or_zero)]
         ui_seconds: Option<f64>,
     },
 }
@@ -401,8 +402,8 @@ struct PortArgs {
     baud: u32,
     /// Seconds to wait for each answer of the board (a frame's State or Dropped, an Ack).
     /// Without a frame's answer by then, a Ping probes for as long again (a slow answer still
-    /// counts); then the frame counts as dropped, "no reply (timeout)".
-    #[arg(long, value_name = "S", default_value_t = 2.0)]
+    /// counts); then the frame counts as dropped, "no reply (timeout)". At most a week.
+    #[arg(long, value_name = "S", default_value_t = 2.0, value_parser = cli_values::positive_seconds)]
     reply_timeout: f64,
 }
 
@@ -548,7 +549,7 @@ fn run(cli: Cli) -> Result<()> {
                 "connect with: digiteyes stream --port {} --seq DIR   (Ctrl-C stops the board)",
                 board.path().display()
             );
-            let every = (report_every > 0.0).then(|| Duration::from_secs_f64(report_every));
+            let every = (report_every > 0.0).then(|| cli_values::duration(report_every));
             digiteyes_host::sim::serve(board, every)?;
         }
         Command::Stream {
@@ -563,7 +564,7 @@ fn run(cli: Cli) -> Result<()> {
         } => {
             let mut options = StreamOptions::new(&port.port)
                 .baud(port.baud)
-                .reply_timeout(reply_timeout(port.reply_timeout)?)
+                .reply_timeout(cli_values::duration(port.reply_timeout))
                 .camera_index(camera_index)
                 .progress(progress && !quiet);
             options.tracker = Default::default();
@@ -603,10 +604,7 @@ fn run(cli: Cli) -> Result<()> {
             options.setup = setup;
             options.camera_index = camera_index;
             options.states = states;
-            options.duration = match seconds {
-                Some(s) => Some(reply_timeout(s)?),
-                None => None,
-            };
+            options.duration = seconds.map(cli_values::duration);
             let link = Link::open(&port.port, port.baud)?;
             eprintln!("listening on {}", port.port);
             let summary = listen(link, &options, &mut std::io::stdout().lock())?;
@@ -650,7 +648,7 @@ fn run(cli: Cli) -> Result<()> {
             let options = UiOptions {
                 bind,
                 source,
-                duration: seconds.map(reply_timeout).transpose()?,
+                duration: seconds.map(cli_values::duration),
             };
             run_ui(&options, &mut std::io::stdout())?;
         }
@@ -669,7 +667,7 @@ fn run(cli: Cli) -> Result<()> {
             println!("report: {}", dir.join(REPORT_HTML).display());
             let interactive = std::io::stdin().is_terminal() && std::io::stdout().is_terminal();
             let serve = match ui_seconds {
-                Some(s) if s > 0.0 => Some(Some(reply_timeout(s)?)),
+                Some(s) if s > 0.0 => Some(Some(cli_values::duration(s))),
                 Some(_) => None,
                 None if interactive => Some(None),
                 None => None,

@@ -2,7 +2,8 @@
 //!
 //! The tracker starts from `initial_state`, estimates the `free` states, and sees every frame
 //! of every camera: one `track` call per instant with one frame per camera. Each instant's
-//! state and report go to the output CSV as soon as it is tracked (header
+//! state and report go to the output CSV (written beside it and put in place when every frame
+//! is tracked, so a failed run leaves an earlier file untouched; header
 //! `frame,q0..q{n-1},rms_px,iterations,features_found,features_expected,lost`).
 //! Optionally each frame of each camera is also drawn with the model, the slices searched and
 //! the features found at the state tracked for it ([`crate::overlay`]), as PNGs.
@@ -103,7 +104,7 @@ pub fn sequence_tracker(
 /// Tracks every frame of the sequence in folder `seq` and writes the states to `out_csv`.
 /// A progress bar goes to stderr when `progress` is set and stderr is a terminal. Fails,
 /// naming the file, on unreadable input; fails naming the frame and its files if the tracker
-/// rejects a frame (the rows of the frames before it stay in `out_csv`).
+/// rejects a frame; then `out_csv` is left as it was (an earlier file stays whole).
 pub fn track_sequence(
     seq: &Path,
     out_csv: &Path,

@@ -78,13 +78,7 @@ pub fn evaluate(seq: &Path, states_csv: &Path) -> Result<EvalReport> {
     let sequence = Sequence::open(seq)?;
     let truth = sequence.read_truth()?;
     let estimated = read_states(states_csv, sequence.n_states())?;
-    ensure!(
-        estimated.rows.len() == sequence.frames,
-        "{}: {} frames, the sequence has {}",
-        states_csv.display(),
-        estimated.rows.len(),
-        sequence.frames
-    );
+    sequence.check_state_rows(states_csv, estimated.rows.len())?;
     let names = (0..sequence.cameras.len())
         .map(|c| sequence.camera_name(c))
         .collect::<Vec<_>>();
@@ -96,7 +90,13 @@ pub fn evaluate(seq: &Path, states_csv: &Path) -> Result<EvalReport> {
         &truth.rows,
         &estimated.rows,
     )
-    .with_context(|| format!("{}", states_csv.display()))?;
+    .with_context(|| {
+        format!(
+            "comparing {} with {}",
+            states_csv.display(),
+            sequence.dir.join(crate::sequence::TRUTH_CSV).display()
+        )
+    })?;
     report.lost_frames = estimated
         .extra("lost")
         .map(|lost| lost.iter().filter(|&&v| v != 0.0).count());

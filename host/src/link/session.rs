@@ -360,12 +360,12 @@ fn placeholder_hello() -> Hello {
     }
 }
 
-/// The reply timeout as a [`Duration`] from seconds given on the command line.
+/// The reply timeout as a [`Duration`] from seconds (`--reply-timeout`), within the range of
+/// [`crate::cli_values::positive_seconds`].
 pub fn reply_timeout(seconds: f64) -> Result<Duration> {
-    if !(seconds.is_finite() && seconds > 0.0) {
-        bail!("--reply-timeout must be a positive number of seconds, not {seconds}");
-    }
-    Ok(Duration::from_secs_f64(seconds))
+    crate::cli_values::positive_seconds(&seconds.to_string())
+        .map_err(|e| anyhow::anyhow!("--reply-timeout: {e}"))?;
+    Ok(crate::cli_values::duration(seconds))
 }
 
 /// A board set up from a sequence description, with the link handed back for listening.

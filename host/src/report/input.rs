@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{ensure, Context, Result};
+use anyhow::{Context, Result};
 
 use crate::sequence::states::{read_states_with_gaps, StatesWithGaps};
 use crate::sequence::{Sequence, StateTable, TRUTH_CSV};
@@ -43,13 +43,7 @@ impl Inputs {
             .with_context(|| format!("cannot open the sequence {}", seq.display()))?;
         let estimate = read_states_with_gaps(states_csv, sequence.n_states())?;
         let frames = estimate.table.rows.len();
-        ensure!(
-            frames == sequence.frames,
-            "{}: {frames} frames, the sequence {} has {}",
-            states_csv.display(),
-            seq.display(),
-            sequence.frames
-        );
+        sequence.check_state_rows(states_csv, frames)?;
         let truth = if seq.join(TRUTH_CSV).exists() {
             Some(sequence.read_truth()?)
         } else {

@@ -22,7 +22,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use digiteyes_core::features::FeatureConfig;
 
 use crate::eval::EvalReport;
@@ -141,7 +141,7 @@ pub fn write_report(
 ) -> Result<ReportSummary> {
     let start = Instant::now();
     let (page, mut summary) = build_report(seq, states_csv, options)?;
-    std::fs::write(out, &page).with_context(|| format!("cannot write {}", out.display()))?;
+    crate::atomic_file::write_atomic(out, page.as_bytes())?;
     summary.out = out.to_path_buf();
     summary.seconds = start.elapsed().as_secs_f64();
     Ok(summary)

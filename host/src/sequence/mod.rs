@@ -139,6 +139,19 @@ impl Sequence {
         Ok(())
     }
 
+    /// The one check every reader of a states file (`eval`, `report`, `ui --replay`) makes:
+    /// it has one row per frame of this sequence, so all of them judge a file alike.
+    pub fn check_state_rows(&self, states_csv: &Path, rows: usize) -> Result<()> {
+        ensure!(
+            rows == self.frames,
+            "{}: {rows} frames of states, the sequence {} has {} (one row per frame is needed)",
+            states_csv.display(),
+            self.dir.display(),
+            self.frames
+        );
+        Ok(())
+    }
+
     /// Reads `truth.csv`; an error if it is missing or does not have one row per frame.
     pub fn read_truth(&self) -> Result<StateTable> {
         let path = self.dir.join(TRUTH_CSV);
@@ -182,7 +195,7 @@ pub fn write_sequence_json(dir: &Path, file: &SequenceFile) -> Result<()> {
     let text = file
         .to_json()
         .with_context(|| format!("cannot encode {}", path.display()))?;
-    std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))
+    crate::atomic_file::write_atomic(&path, text.as_bytes())
 }
 
 /// Writes frame `frame` of camera `cam` into sequence folder `dir` (the folder must exist).

@@ -4,8 +4,7 @@
 //! in mm, joint angles in rad); the tracker's output adds report columns after them. Rows are
 //! one per frame, in order, numbers as plain decimals.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -145,7 +144,12 @@ fn parse_table(text: &str, n_states: usize, gaps: bool) -> Result<StatesWithGaps
         }
         let frame: usize = fields[0]
             .parse()
-            .with_context(|| format!("line {number}: frame `{}` is not a number", fields[0]))?;
+            .with_context(|| {
+                format!(
+                    "line {number}: frame {} is not a number",
+                    crate::text::quote_value(fields[0])
+                )
+            })?;
         if frame != table.rows.len() {
             bail!(
                 "line {number}: frame {frame} out of order, expected frame {}",
@@ -155,9 +159,14 @@ fn parse_table(text: &str, n_states: usize, gaps: bool) -> Result<StatesWithGaps
         let mut state = Vec::with_capacity(n_states);
         for (i, field) in fields[1..=n_states].iter().enumerate() {
             match field.parse::<f64>() {
-                Ok(v) if v.is_finite() => state.push(v),
+                // The tracker and the evaluation work in f32: a value past f32's range
+                // would become infinite there, so it is refused here, naming this file.
+                Ok(v) if v.is_finite() && (v as f32).is_finite() => state.push(v),
                 _ if gaps => state.push(f64::NAN),
-                _ => bail!("line {number}: q{i} = `{field}` is not a finite number"),
+                _ => bail!(
+                    "line {number}: q{i} = {} is not a finite number within f32's range",
+                    crate::text::quote_value(field)
+                ),
             }
         }
         let extras = fields[n_states + 1..]
@@ -188,13 +197,17 @@ pub fn write_truth(path: &Path, rows: &[Vec<f64>]) -> Result<()> {
         }
         text.push('\n');
     }
-    std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
+    crate::atomic_file::write_atomic(path, text.as_bytes())
 }
 
 /// Writes the tracker's output CSV row by row: `frame,q0..q{n-1}` then [`REPORT_COLUMNS`].
 /// The quaternion is normalised before writing; `lost` is written as 0 or 1.
+///
+/// The rows go to a temporary file beside `path`, renamed onto it by
+/// [`StatesWriter::finish`]: a run that fails part-way leaves an existing file at `path` as
+/// it was, never a partial one.
 pub struct StatesWriter {
-    out: BufWriter<File>,
+    out: crate::atomic_file::AtomicFile,
     path: PathBuf,
     n_states: usize,
     extra_columns: usize,
@@ -210,10 +223,8 @@ impl StatesWriter {
     /// Creates `path` and writes the header, with `extra` columns after [`REPORT_COLUMNS`]
     /// (their values are given to [`StatesWriter::write_with`]).
     pub fn with_columns(path: &Path, n_states: usize, extra: &[&str]) -> Result<Self> {
-        let file =
-            File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
         let mut writer = StatesWriter {
-            out: BufWriter::new(file),
+            out: crate::atomic_file::AtomicFile::create(path)?,
             path: path.to_path_buf(),
             n_states,
             extra_columns: extra.len(),
@@ -283,11 +294,10 @@ impl StatesWriter {
         Ok(())
     }
 
-    /// Flushes the file; returns the number of rows written.
-    pub fn finish(mut self) -> Result<usize> {
-        self.out
-            .flush()
-            .with_context(|| format!("cannot write {}", self.path.display()))?;
+    /// Completes the file and puts it in place at its path; returns the number of rows
+    /// written. Without this, nothing is written there.
+    pub fn finish(self) -> Result<usize> {
+        self.out.commit()?;
         Ok(self.frames)
     }
 

@@ -102,6 +102,7 @@ impl Replay {
         let table = read_states_with_gaps(states_csv, sequence.n_states())?;
         let column = |name: &str| table.table.extra(name);
         let rows = table.table.rows.len();
+        sequence.check_state_rows(states_csv, rows)?;
         let lost = column("lost").unwrap_or_else(|| vec![0.0; rows]);
         let rms = column("rms_px").unwrap_or_else(|| vec![f64::NAN; rows]);
         let found = column("features_found").unwrap_or_else(|| vec![0.0; rows]);
@@ -126,16 +127,28 @@ impl Replay {
                 (shown, drop)
             })
             .collect();
-        let fps = fps.or(sequence.fps()).unwrap_or(15.0);
-        if !(fps > 0.0 && fps.is_finite()) {
-            bail!("replay rate {fps} frames/s: must be above 0");
-        }
+        let fps = match (fps, sequence.fps()) {
+            (Some(fps), _) => {
+                crate::cli_values::check_fps(fps).map_err(|e| anyhow::anyhow!("--fps: {e}"))?;
+                fps
+            }
+            (None, Some(fps)) => {
+                crate::cli_values::check_fps(fps).map_err(|e| {
+                    anyhow::anyhow!(
+                        "{}: \"fps\": {e} (or give --fps)",
+                        sequence.dir.join("sequence.json").display()
+                    )
+                })?;
+                fps
+            }
+            (None, None) => 15.0,
+        };
         Ok(Replay {
             sequence,
             states,
             camera,
             camera_index,
-            period: Duration::from_secs_f64(1.0 / fps),
+            period: crate::cli_values::frame_period(fps),
         })
     }
 
