@@ -218,7 +218,10 @@ impl fmt::Display for ModelErrorKind {
             Self::Cycle { frame } => write!(f, "cycle in `next` through frame {frame}"),
             Self::Unreachable { frame } => write!(f, "frame {frame} is not reached from frame 0"),
             Self::TooManyFrames => {
-                write!(f, "more than {MAX_FRAMES} frames (a model has at most {MAX_FRAMES})")
+                write!(
+                    f,
+                    "more than {MAX_FRAMES} frames (a model has at most {MAX_FRAMES})"
+                )
             }
             Self::FrameBeyondLimit { frame } => write!(
                 f,

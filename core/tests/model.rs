@@ -634,7 +634,11 @@ fn too_many_frames() {
             frame: MAX_FRAMES as u16
         }
     );
-    assert!(e.to_string().contains(&format!("at most {MAX_FRAMES} frames")), "{e}");
+    assert!(
+        e.to_string()
+            .contains(&format!("at most {MAX_FRAMES} frames")),
+        "{e}"
+    );
 }
 
 /// A palm with `n` joint frames q7.. hanging from it in a straight chain.

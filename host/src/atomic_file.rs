@@ -108,7 +108,11 @@ mod tests {
             f.write_all(b"partial").unwrap();
         }
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "good\n");
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "temp file left");
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "temp file left"
+        );
         write_atomic(&path, b"new\n").unwrap();
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "new\n");
     }

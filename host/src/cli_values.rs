@@ -37,7 +37,7 @@ fn number(text: &str) -> Result<f64, String> {
 /// Seconds, strictly positive and at most [`MAX_SECONDS`] (`--seconds`, `--reply-timeout`).
 pub fn positive_seconds(text: &str) -> Result<f64, String> {
     let s = number(text)?;
-    if !(s >= MIN_REPLY_SECONDS && s <= MAX_SECONDS) {
+    if !(MIN_REPLY_SECONDS..=MAX_SECONDS).contains(&s) {
         return Err(format!(
             "{s} s is out of range: give {MIN_REPLY_SECONDS} to {MAX_SECONDS} seconds (a week)"
         ));
@@ -52,7 +52,7 @@ pub fn seconds_or_zero(text: &str) -> Result<f64, String> {
     if s == 0.0 {
         return Ok(0.0);
     }
-    if !(s >= MIN_REPLY_SECONDS && s <= MAX_SECONDS) {
+    if !(MIN_REPLY_SECONDS..=MAX_SECONDS).contains(&s) {
         return Err(format!(
             "{s} s is out of range: give 0 or {MIN_REPLY_SECONDS} to {MAX_SECONDS} seconds (a week)"
         ));
@@ -121,7 +121,9 @@ pub fn frame_count(text: &str) -> Result<usize, String> {
         .parse()
         .map_err(|_| format!("{} is not a whole number", quote_value(text)))?;
     if !(1..=MAX_FRAMES).contains(&n) {
-        return Err(format!("{n} frames is out of range: give 1 to {MAX_FRAMES}"));
+        return Err(format!(
+            "{n} frames is out of range: give 1 to {MAX_FRAMES}"
+        ));
     }
     Ok(n)
 }
@@ -130,7 +132,9 @@ pub fn frame_count(text: &str) -> Result<usize, String> {
 pub fn positive(text: &str) -> Result<f32, String> {
     let v = number(text)?;
     if !(v > 0.0 && v <= 1e6) {
-        return Err(format!("{v} is out of range: give a number above 0, at most 1e6"));
+        return Err(format!(
+            "{v} is out of range: give a number above 0, at most 1e6"
+        ));
     }
     Ok(v as f32)
 }

@@ -102,7 +102,8 @@ pub fn listen(link: Link, options: &ListenOptions, out: &mut dyn Write) -> Resul
         if options.json {
             writeln!(out, "{}", serde_json::to_string(&message)?)?;
         } else {
-            writeln!(out, "{}", describe(&message))?;
+            // A board's strings (its name) are the board's to choose: never raw to a terminal.
+            writeln!(out, "{}", crate::text::escape_control(&describe(&message)))?;
         }
         out.flush()?;
         if let Some(forwarder) = &mut forwarder {
@@ -260,5 +261,40 @@ mod tests {
             assert_eq!(addrs[0], "/digiteyes/state", "frame {frame}");
             assert_eq!(addrs.last().unwrap(), "/digiteyes/mouse", "frame {frame}");
         }
+    }
+
+    /// A board's name is the board's to choose: an escape sequence in it (here one that
+    /// clears the screen) reaches the terminal as visible text, never as control bytes.
+    #[test]
+    fn a_boards_control_characters_are_escaped_in_text_output() {
+        use digiteyes_core::protocol::{Capacities, Hello};
+        let (mut board, slave) = TTYPort::pair().unwrap();
+        let link = Link::open(&slave.name().unwrap(), 115_200).unwrap();
+        let hello = BoardMessage::Hello(Hello {
+            version: 1,
+            board: "evil\u{1b}[2J\u{7}".try_into().unwrap(),
+            model_digest: 0,
+            clock_hz: 1000,
+            capacities: Capacities {
+                states: 28,
+                max_states: 28,
+                max_frames: 37,
+                max_frame_bytes: 64,
+                max_chunk: 1024,
+                max_message: 2048,
+            },
+        });
+        let mut buf = [0u8; MAX_MESSAGE];
+        board.write_all(encode(&hello, &mut buf).unwrap()).unwrap();
+        let options = ListenOptions {
+            duration: Some(Duration::from_millis(500)),
+            ..ListenOptions::default()
+        };
+        let mut out = Vec::new();
+        let summary = listen(link, &options, &mut out).unwrap();
+        assert_eq!(summary.messages, 1);
+        let text = String::from_utf8(out).unwrap();
+        assert!(!text.bytes().any(|b| b == 0x1b || b == 0x07), "{text:?}");
+        assert!(text.contains("evil\\u{1b}[2J\\u{7}"), "{text:?}");
     }
 }

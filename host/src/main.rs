@@ -10,10 +10,10 @@ use std::process::ExitCode;
 use anyhow::{bail, Result};
 use clap::{Args, Parser, Subcommand};
 use digiteyes_board_linux::SimOptions;
+use digiteyes_host::cli_values;
 use digiteyes_host::demo::{run_demo, serve_demo_ui, DEFAULT_DEMO_DIR, REPORT_HTML};
 use digiteyes_host::forward::one_euro::{self, Smoothing};
 use digiteyes_host::forward::parse_forward;
-use digiteyes_host::cli_values;
 use digiteyes_host::link::Link;
 use digiteyes_host::listen::{listen, ListenOptions};
 use digiteyes_host::scenarios::{render_scenario, RenderOptions, DEFAULT_FRAMES, NAMES};
@@ -576,6 +576,7 @@ fn run(cli: Cli) -> Result<()> {
                 _ => bail!("give --seq DIR, or --camera /dev/videoN with --setup FILE"),
             };
             println!("{summary}");
+            summary.ensure_some_tracked()?;
         }
         Command::Listen {
             port,

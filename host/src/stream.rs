@@ -107,6 +107,20 @@ impl StreamSummary {
         self.link.tracked
     }
 
+    /// An error when the board tracked none of the frames: a run that produced no state is a
+    /// failure, whatever the reasons its frames were dropped for.
+    pub fn ensure_some_tracked(&self) -> Result<()> {
+        if self.tracked() == 0 {
+            anyhow::bail!(
+                "the board tracked none of the {} frame(s) (the drops are listed above); {} \
+                 holds no tracked state",
+                self.frames,
+                self.out.display()
+            );
+        }
+        Ok(())
+    }
+
     /// The dropped frames and why, in order.
     pub fn dropped(&self) -> Vec<(usize, DropCause)> {
         self.outcomes
@@ -227,6 +241,7 @@ pub fn stream_sequence(
     let sequence = Sequence::open(seq)?;
     let camera = pick_camera(&sequence, options.camera_index)?;
     sequence.check_frames()?;
+    sequence.check_cameras_see_the_hand(&[camera])?;
     let session = connect(&sequence, options)?;
     let frames = (0..sequence.frames).map(|k| {
         let image = sequence.read_frame(camera, k)?;
@@ -402,5 +417,21 @@ mod tests {
             ..summary
         };
         assert!(none.board_work().is_none() && !none.to_string().contains("board work"));
+    }
+
+    #[test]
+    fn a_run_with_nothing_tracked_is_an_error() {
+        let mut summary = StreamSummary {
+            frames: 2,
+            outcomes: vec![FrameOutcome::Dropped(DropCause::Board(DropReason::Incomplete)); 2],
+            mean_rms_px: 0.0,
+            out: PathBuf::from("states.csv"),
+            link: LinkReport::default(),
+            board_clock_hz: 1,
+        };
+        let e = summary.ensure_some_tracked().unwrap_err().to_string();
+        assert!(e.contains("tracked none of the 2 frame(s)"), "{e}");
+        summary.link.tracked = 1;
+        assert!(summary.ensure_some_tracked().is_ok());
     }
 }

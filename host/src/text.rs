@@ -40,7 +40,10 @@ mod tests {
 
     #[test]
     fn control_characters_are_escaped() {
-        assert_eq!(escape_control("a\u{1b}[31mred\u{7}"), "a\\u{1b}[31mred\\u{7}");
+        assert_eq!(
+            escape_control("a\u{1b}[31mred\u{7}"),
+            "a\\u{1b}[31mred\\u{7}"
+        );
         assert_eq!(escape_control("x\ny\u{9b}z"), "x\\ny\\u{9b}z");
         assert_eq!(escape_control("Zürich ✓"), "Zürich ✓");
     }

@@ -127,6 +127,7 @@ pub fn track_sequence_with(
     let start = Instant::now();
     let sequence = Sequence::open(seq)?;
     sequence.check_frames()?;
+    sequence.check_cameras_see_the_hand(&(0..sequence.cameras.len()).collect::<Vec<_>>())?;
     let mut tracker = sequence_tracker(&sequence, config)
         .map_err(|e| anyhow!("{}: cannot start the tracker: {e}", seq.display()))?;
     let mut writer = StatesWriter::create(out_csv, sequence.n_states())?;

@@ -146,7 +146,7 @@ impl Session {
         report.bytes_up = self.link.bytes_up();
         report.bytes_down = self.link.bytes_down();
         report.host_link = self.link.counters();
-        report.board_name = self.hello.board.to_string();
+        report.board_name = crate::text::escape_control(&self.hello.board);
         report
     }
 
@@ -309,7 +309,7 @@ impl Session {
         if hello.version != PROTOCOL_VERSION {
             bail!(
                 "board {} on {} speaks protocol version {}, this host speaks version {}",
-                hello.board,
+                crate::text::escape_control(&hello.board),
                 self.link.path(),
                 hello.version,
                 PROTOCOL_VERSION
@@ -320,7 +320,7 @@ impl Session {
                 "board {} on {} tracks another model (digest {:#010x}) than the sequence's \
                  `{}` (digest {:#010x}): the board's is built in; track this sequence with \
                  `digiteyes track` instead",
-                hello.board,
+                crate::text::escape_control(&hello.board),
                 self.link.path(),
                 hello.model_digest,
                 self.setup.model_name,
@@ -398,7 +398,7 @@ pub fn set_up_board(
     writeln!(
         out,
         "board {} set up from {}",
-        session.hello().board,
+        crate::text::escape_control(&session.hello().board),
         json.display()
     )?;
     let hello = session.hello().clone();

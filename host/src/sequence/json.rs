@@ -21,6 +21,8 @@ pub struct SequenceFile {
     /// The cameras; camera `i`'s frames are in folder `cam{i}`.
     pub cameras: Vec<CameraFile>,
     /// The state at frame 0: quaternion `w, x, y, z`, translation (mm), joint angles (rad).
+    /// Optional in the format (empty when absent); the tracker needs it today.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub initial_state: Vec<f64>,
     /// The states the tracker estimates; absent means all.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -81,9 +83,31 @@ impl CameraFile {
 }
 
 impl SequenceFile {
-    /// Parses the text of a `sequence.json`.
-    pub fn from_json(text: &str) -> Result<Self, serde_json::Error> {
-        serde_json::from_str(text)
+    /// Parses the text of a `sequence.json`. The error names the key at fault
+    /// (`cameras[0].fx: ...`) as well as the line and column, and says so when the value is a
+    /// `NaN` or `Infinity`, which JSON does not have.
+    pub fn from_json(text: &str) -> Result<Self, String> {
+        let mut de = serde_json::Deserializer::from_str(text);
+        let parsed: Result<Self, serde_path_to_error::Error<serde_json::Error>> =
+            serde_path_to_error::deserialize(&mut de);
+        let (path, inner) = match parsed {
+            Ok(file) => match de.end() {
+                Ok(()) => return Ok(file),
+                Err(e) => (String::new(), e),
+            },
+            Err(e) => (e.path().to_string(), e.into_inner()),
+        };
+        let mut message = if path.is_empty() || path == "." {
+            inner.to_string()
+        } else {
+            format!("`{path}`: {inner}")
+        };
+        if let Some(word) = non_number_at(text, inner.line(), inner.column()) {
+            message.push_str(&format!(
+                " (`{word}` is not a JSON number: every value must be a finite number)"
+            ));
+        }
+        Err(message)
     }
 
     /// The file's text (pretty-printed JSON, trailing newline).
@@ -92,4 +116,23 @@ impl SequenceFile {
         text.push('\n');
         Ok(text)
     }
+}
+
+/// The word at 1-based `line`, `column` (serde_json's error position) if it spells a number
+/// JSON does not have (`NaN`, `Infinity`, `-Infinity`, `inf`).
+fn non_number_at(text: &str, line: usize, column: usize) -> Option<&'static str> {
+    let row = text.lines().nth(line.checked_sub(1)?)?;
+    let from = column.saturating_sub(1).min(row.len());
+    let rest = row
+        .get(from..)
+        .or_else(|| row.get(column.min(row.len())..))?;
+    let rest = rest.trim_start().to_ascii_lowercase();
+    ["-infinity", "infinity", "nan", "-inf", "inf"]
+        .into_iter()
+        .find(|w| rest.starts_with(w))
+        .map(|w| match w {
+            "nan" => "NaN",
+            "infinity" | "inf" => "Infinity",
+            _ => "-Infinity",
+        })
 }

@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, ensure, Context, Result};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::config::MAX_CAMERAS;
+use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Model;
 use image::GrayImage;
 
@@ -65,8 +66,9 @@ impl Sequence {
         let dir = json_path.parent().unwrap_or(Path::new("."));
         let text = std::fs::read_to_string(json_path)
             .with_context(|| format!("cannot read {}", json_path.display()))?;
-        let file = SequenceFile::from_json(&text)
-            .with_context(|| format!("{}: invalid sequence description", json_path.display()))?;
+        let file = SequenceFile::from_json(&text).map_err(|e| {
+            anyhow::anyhow!("{}: invalid sequence description: {e}", json_path.display())
+        })?;
         let at = |what: String| format!("{}: {what}", json_path.display());
         let model = load_model(dir, &file.model).with_context(|| at("model".into()))?;
         let cameras = check_cameras(&file.cameras).with_context(|| at("cameras".into()))?;
@@ -150,6 +152,50 @@ impl Sequence {
             self.frames
         );
         Ok(())
+    }
+
+    /// Refuses a camera that cannot see the hand at its initial state: every link behind it
+    /// or projected outside its frame (a hand placed behind the camera, absurd intrinsics such
+    /// as fx = 1e30). Tracking such a camera could only report every frame lost.
+    pub fn check_cameras_see_the_hand(&self, cameras: &[usize]) -> Result<()> {
+        let q: Vec<f32> = self.initial_state.iter().map(|&v| v as f32).collect();
+        let poses = Poses::compute(&self.model, &q)
+            .map_err(|e| anyhow::anyhow!("{}: initial_state: {e}", self.json_path().display()))?;
+        for &c in cameras {
+            let camera = &self.cameras[c];
+            let (w, h) = (camera.width as f32, camera.height as f32);
+            let (mut behind, mut inside) = (0, 0);
+            for i in 0..self.model.links().len() {
+                let Some(p) = poses.origin(i) else { continue };
+                match camera.project(&p) {
+                    None => behind += 1,
+                    Some(uv)
+                        if uv.x >= -0.5 && uv.y >= -0.5 && uv.x <= w - 0.5 && uv.y <= h - 0.5 =>
+                    {
+                        inside += 1
+                    }
+                    Some(_) => {}
+                }
+            }
+            if inside == 0 {
+                let why = if behind > 0 {
+                    "the hand is behind it"
+                } else {
+                    "no joint of the hand projects into its frame"
+                };
+                bail!(
+                    "{}: camera {c} ({}) cannot see the hand at initial_state: {why} \
+                     (check its R, t and fx, fy, cx, cy)",
+                    self.json_path().display(),
+                    self.camera_name(c)
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn json_path(&self) -> PathBuf {
+        self.dir.join(SEQUENCE_JSON)
     }
 
     /// Reads `truth.csv`; an error if it is missing or does not have one row per frame.
@@ -257,6 +303,13 @@ pub fn check_cameras(cameras: &[CameraFile]) -> Result<Vec<Camera>> {
 
 fn check_initial_state(state: &[f64], model: &Model) -> Result<Vec<f64>> {
     ensure!(
+        !state.is_empty(),
+        "missing: the format allows leaving out the starting state, but digiteyes does not \
+         find the hand by itself yet; give the state at frame 0 ({} numbers: quaternion \
+         w x y z, translation in mm, joint angles in rad)",
+        model.n_states()
+    );
+    ensure!(
         state.len() == model.n_states(),
         "{} values, the model has {} states",
         state.len(),
@@ -320,8 +373,21 @@ fn count_frames(dir: &Path, cam: usize) -> Result<usize> {
         folder.display()
     );
     let mut n = 0;
-    while frame_path(dir, cam, n).is_file() {
-        n += 1;
+    loop {
+        let path = frame_path(dir, cam, n);
+        match std::fs::metadata(&path) {
+            Ok(meta) if meta.is_file() => n += 1,
+            Ok(meta) => bail!(
+                "{}: {}, not a PGM frame",
+                path.display(),
+                if meta.is_dir() {
+                    "is a folder"
+                } else {
+                    "is not a regular file (a pipe, socket or device)"
+                }
+            ),
+            Err(_) => break,
+        }
     }
     ensure!(
         n > 0,

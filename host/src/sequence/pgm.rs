@@ -5,7 +5,7 @@ use std::fs::File;
 use std::io::{BufReader, BufWriter, Write};
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use image::codecs::pnm::{PnmDecoder, PnmEncoder, PnmSubtype, SampleEncoding};
 use image::{ExtendedColorType, GrayImage, ImageDecoder};
 
@@ -33,7 +33,7 @@ pub fn read_pgm_checked(
     let mut pixels = vec![0u8; decoder.total_bytes() as usize];
     decoder
         .read_image(&mut pixels)
-        .with_context(|| format!("{}: cannot read the pixels", path.display()))?;
+        .map_err(|e| anyhow!("{}: cannot read the pixels: {e}", path.display()))?;
     GrayImage::from_raw(width, height, pixels)
         .with_context(|| format!("{}: pixel data does not fill the image", path.display()))
 }
@@ -57,8 +57,10 @@ pub fn write_pgm(path: &Path, image: &GrayImage) -> Result<()> {
 
 fn open_decoder(path: &Path) -> Result<PnmDecoder<BufReader<File>>> {
     let file = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
+    // The `image` crate's errors already say what their source says: shown once, not chained
+    // (a chain would print the cause twice).
     let decoder = PnmDecoder::new(BufReader::new(file))
-        .with_context(|| format!("{}: not a readable PGM file", path.display()))?;
+        .map_err(|e| anyhow!("{}: not a readable PGM file: {e}", path.display()))?;
     let header = decoder.header();
     if header.subtype() != PnmSubtype::Graymap(SampleEncoding::Binary) {
         bail!(

@@ -142,14 +142,12 @@ fn parse_table(text: &str, n_states: usize, gaps: bool) -> Result<StatesWithGaps
                 columns.len()
             );
         }
-        let frame: usize = fields[0]
-            .parse()
-            .with_context(|| {
-                format!(
-                    "line {number}: frame {} is not a number",
-                    crate::text::quote_value(fields[0])
-                )
-            })?;
+        let frame: usize = fields[0].parse().with_context(|| {
+            format!(
+                "line {number}: frame {} is not a number",
+                crate::text::quote_value(fields[0])
+            )
+        })?;
         if frame != table.rows.len() {
             bail!(
                 "line {number}: frame {frame} out of order, expected frame {}",
