@@ -187,17 +187,27 @@ impl Replay {
             return Ok(());
         }
         let mut next = Instant::now();
+        let mut last_complaint: Option<Instant> = None;
         for (i, (state, drop)) in self.states.iter().enumerate().cycle() {
             if stop.load(Ordering::Relaxed) {
                 break;
             }
-            let image = self.sequence.read_frame(self.camera_index, i)?;
-            hub.push_frame(CameraFrame {
-                frame: state.frame,
-                camera: self.camera,
-                image,
-                q: state.q.clone(),
-            });
+            // A frame that cannot be read now (the process out of descriptors, the file
+            // being replaced) costs that frame's picture only: the states play on.
+            match self.sequence.read_frame(self.camera_index, i) {
+                Ok(image) => hub.push_frame(CameraFrame {
+                    frame: state.frame,
+                    camera: self.camera,
+                    image,
+                    q: state.q.clone(),
+                }),
+                Err(e) => {
+                    if last_complaint.is_none_or(|t| t.elapsed() > Duration::from_secs(10)) {
+                        eprintln!("digiteyes: replay: frame {i} not shown: {e:#}");
+                        last_complaint = Some(Instant::now());
+                    }
+                }
+            }
             match drop {
                 Some(reason) => hub.push_host_drop(reason),
                 None => hub.push_state(state.clone()),
