@@ -308,6 +308,22 @@ impl NormalEquations {
         }
     }
 
+    /// Adds a prior on one state: `weight · (q − centre)²` with `offset = q − centre` (the
+    /// state's units), i.e. `weight` on the diagonal and `weight · offset` on `JᵀWr`. Not a
+    /// residual: it changes neither [`rows`](Self::rows) nor [`rms`](Self::rms). Ignored for a
+    /// state that is not free, or for a non-finite or non-positive weight.
+    pub fn add_prior(&mut self, state: usize, weight: f32, offset: f32, free: FreeMask) {
+        if state >= MAX_STATES
+            || !free.contains(state)
+            || !(weight > 0.0 && weight.is_finite() && offset.is_finite())
+        {
+            return;
+        }
+        let p = position(state);
+        self.diag[p] += weight;
+        self.jtr[p] += weight * offset;
+    }
+
     /// Rows added since the last clear.
     pub fn rows(&self) -> u16 {
         self.rows

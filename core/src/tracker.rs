@@ -18,6 +18,7 @@ use crate::features::{find_link_features, FeatureConfig, LinkFeatures};
 use crate::frame::{FrameError, FrameView};
 use crate::kinematics::{KinematicsError, Poses};
 use crate::model::Model;
+use crate::motion::{velocity_trust, MotionConfig};
 use crate::projection::ProjectedModel;
 
 /// Tracker parameters.
@@ -41,6 +42,8 @@ pub struct TrackerConfig {
     pub features: FeatureConfig,
     /// Residual and solve parameters.
     pub estimator: EstimatorConfig,
+    /// Prediction, prior toward it, and what a lost frame keeps.
+    pub motion: MotionConfig,
 }
 
 impl Default for TrackerConfig {
@@ -54,6 +57,7 @@ impl Default for TrackerConfig {
             lost_rms_px: 6.0,
             features: FeatureConfig::default(),
             estimator: EstimatorConfig::default(),
+            motion: MotionConfig::default(),
         }
     }
 }
@@ -131,7 +135,9 @@ pub struct Tracker {
     model: Model,
     cameras: Vec<Camera, MAX_CAMERAS>,
     state: Vec<f32, MAX_STATES>,
-    previous: Option<Vec<f32, MAX_STATES>>,
+    /// The change of each state over the last frame, scaled by how far that frame's evidence
+    /// is trusted; `None` before the first frame and after a reset.
+    velocity: Option<[f32; MAX_STATES]>,
     free: FreeMask,
     config: TrackerConfig,
     work: Workspace,
@@ -178,7 +184,7 @@ impl Tracker {
             model,
             cameras,
             state: Vec::new(),
-            previous: None,
+            velocity: None,
             free: mask,
             config,
             work: Workspace {
@@ -205,7 +211,7 @@ impl Tracker {
         if let Some(u) = crate::quaternion::normalised([state[0], state[1], state[2], state[3]]) {
             self.state[..4].copy_from_slice(&u);
         }
-        self.previous = None;
+        self.velocity = None;
         Ok(())
     }
 
@@ -249,11 +255,12 @@ impl Tracker {
             }
         }
         let start = self.state.clone();
-        let mut q = self.predicted();
+        let predicted = self.predicted();
+        let mut q = predicted.clone();
         let mut report = FrameReport::default();
         self.work.reach = [[f32::INFINITY; MAX_FRAMES]; MAX_CAMERAS];
         for k in 0..self.config.iterations.max(1) {
-            let Some(step) = self.iterate(&q, frames, k > 0, &mut report) else {
+            let Some(step) = self.iterate(&q, &predicted, frames, k > 0, &mut report) else {
                 report.lost = true;
                 break;
             };
@@ -267,11 +274,27 @@ impl Tracker {
         let expected = f32::from(report.features_expected).max(1.0);
         report.lost |= found < self.config.lost_min_found * expected
             || report.rms_px > self.config.lost_rms_px;
-        if q.iter().all(|v| v.is_finite()) {
-            self.previous = Some(start);
+        let finite = q.iter().all(|v| v.is_finite());
+        report.lost |= !finite;
+        let motion = &self.config.motion;
+        if finite && !(report.lost && motion.hold_when_lost) {
+            let trust = velocity_trust(
+                found / expected,
+                self.config.lost_min_found,
+                motion.full_velocity_found,
+            );
+            let mut velocity = [0.0f32; MAX_STATES];
+            for ((v, new), old) in velocity.iter_mut().zip(q.iter()).zip(start.iter()) {
+                *v = *new - *old;
+                if trust < 1.0 {
+                    *v *= trust;
+                }
+            }
+            self.velocity = Some(velocity);
             self.state = q;
-        } else {
-            report.lost = true;
+        } else if motion.hold_when_lost {
+            // Keep the last good state; a lost frame's motion is not evidence.
+            self.velocity = None;
         }
         Ok(report)
     }
@@ -279,10 +302,10 @@ impl Tracker {
     /// The start state of a frame: constant-velocity extrapolation of the free states.
     fn predicted(&self) -> Vec<f32, MAX_STATES> {
         let mut q = self.state.clone();
-        if let (true, Some(prev)) = (self.config.predict, &self.previous) {
+        if let (true, Some(velocity)) = (self.config.predict, &self.velocity) {
             for (i, v) in q.iter_mut().enumerate() {
                 if self.free.contains(i) {
-                    *v += *v - prev[i];
+                    *v += velocity[i];
                     if let Some(limit) = self.model.limit(i) {
                         *v = v.clamp(limit.lo, limit.hi);
                     }
@@ -299,6 +322,7 @@ impl Tracker {
     fn iterate(
         &mut self,
         q: &[f32],
+        predicted: &[f32],
         frames: &[FrameView<'_>],
         refine: bool,
         report: &mut FrameReport,
@@ -369,6 +393,11 @@ impl Tracker {
         report.rms_px = work.normal.rms();
         if work.normal.rows() == 0 {
             return None;
+        }
+        let prior = &config.motion.prior;
+        for (i, (now, centre)) in q.iter().zip(predicted).enumerate() {
+            work.normal
+                .add_prior(i, prior.for_state(i), *now - *centre, self.free);
         }
         work.normal.step(
             self.model.n_states(),
