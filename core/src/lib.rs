@@ -16,6 +16,7 @@
 //! - [`features`]: the slice edge search of Sec. 4.3.1 with occlusion masking.
 //! - [`estimator`]: residuals, row-by-row normal equations, conditioned Gauss–Newton (Eq. 2.22).
 //! - [`motion`]: the prediction between frames, the prior toward it, what a lost frame keeps.
+//! - [`silhouette`]: how well the projected silhouette agrees with the image (region evidence).
 //! - [`tracker`]: the per-frame loop and its report.
 //! - [`measurement`]: measured axis lines and fingertips at a state, for a stereo host.
 //! - [`protocol`]: the board link's messages and their framing (`docs/protocol.md`).
@@ -40,6 +41,7 @@ pub mod motion;
 pub mod projection;
 pub mod protocol;
 pub mod quaternion;
+pub mod silhouette;
 pub mod tracker;
 pub mod visibility;
 

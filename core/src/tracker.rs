@@ -38,6 +38,11 @@ pub struct TrackerConfig {
     pub lost_min_found: f32,
     /// The frame is `lost` when the residual RMS exceeds this (px).
     pub lost_rms_px: f32,
+    /// The frame is `lost` when the silhouette agreement of any camera is below this (0..=1;
+    /// 0 turns the check off).
+    pub lost_min_silhouette: f32,
+    /// Samples along each side of the silhouette check's grid (0: no check).
+    pub silhouette_grid: u8,
     /// Slice search parameters.
     pub features: FeatureConfig,
     /// Residual and solve parameters.
@@ -55,6 +60,8 @@ impl Default for TrackerConfig {
             converged_mm: 5e-3,
             lost_min_found: 0.3,
             lost_rms_px: 6.0,
+            lost_min_silhouette: 0.0,
+            silhouette_grid: 0,
             features: FeatureConfig::default(),
             estimator: EstimatorConfig::default(),
             motion: MotionConfig::default(),
@@ -78,6 +85,10 @@ pub struct FrameReport {
     pub links_skipped: u16,
     /// Iterations run.
     pub iterations: u8,
+    /// The silhouette's agreement with the image in the last iteration, the smallest over the
+    /// cameras that could score it (0..=1; [`silhouette`](crate::silhouette)); 1 when none
+    /// could or the check is off.
+    pub silhouette_agreement: f32,
     /// Too few features, or the residual exploded: the state is not to be trusted.
     pub lost: bool,
 }
@@ -270,6 +281,8 @@ impl Tracker {
                 break;
             }
         }
+        report.silhouette_agreement = self.silhouette_agreement(frames);
+        report.lost |= report.silhouette_agreement < self.config.lost_min_silhouette;
         let found = f32::from(report.features_found);
         let expected = f32::from(report.features_expected).max(1.0);
         report.lost |= found < self.config.lost_min_found * expected
@@ -297,6 +310,22 @@ impl Tracker {
             self.velocity = None;
         }
         Ok(report)
+    }
+
+    /// The smallest silhouette agreement over the cameras, with the views of the last
+    /// iteration (1 when no camera can be scored or the check is off).
+    fn silhouette_agreement(&self, frames: &[FrameView<'_>]) -> f32 {
+        if self.config.silhouette_grid == 0 {
+            return 1.0;
+        }
+        let mut least = 1.0f32;
+        for ((view, camera), frame) in self.work.views.iter().zip(&self.cameras).zip(frames) {
+            let grid = usize::from(self.config.silhouette_grid);
+            if let Some(score) = crate::silhouette::score(view, camera, frame, grid) {
+                least = least.min(score.agreement);
+            }
+        }
+        least
     }
 
     /// The start state of a frame: constant-velocity extrapolation of the free states.
