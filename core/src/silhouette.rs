@@ -73,7 +73,11 @@ pub fn covers(view: &ProjectedModel, camera: &Camera, p: &Vector2<f32>) -> bool 
 
 /// The image bounds of everything projected, or `None` when nothing is.
 pub fn hand_bounds(view: &ProjectedModel) -> Option<Bounds> {
-    let mut all = view.links.iter().map(|l| l.bounds).chain(view.palm.map(|p| p.bounds));
+    let mut all = view
+        .links
+        .iter()
+        .map(|l| l.bounds)
+        .chain(view.palm.map(|p| p.bounds));
     let first = all.next()?;
     Some(all.fold(first, |acc, b| Bounds {
         min: Vector2::new(acc.min.x.min(b.min.x), acc.min.y.min(b.min.y)),

@@ -21,6 +21,9 @@ use crate::model::Model;
 use crate::motion::{velocity_trust, MotionConfig};
 use crate::projection::ProjectedModel;
 
+/// How fast the silhouette reference follows the frames not lost (share per frame).
+pub const SILHOUETTE_REFERENCE_RATE: f32 = 0.05;
+
 /// Tracker parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -38,9 +41,11 @@ pub struct TrackerConfig {
     pub lost_min_found: f32,
     /// The frame is `lost` when the residual RMS exceeds this (px).
     pub lost_rms_px: f32,
-    /// The frame is `lost` when the silhouette agreement of any camera is below this (0..=1;
-    /// 0 turns the check off).
-    pub lost_min_silhouette: f32,
+    /// The frame is `lost` when the silhouette agreement falls this far below its reference
+    /// (0..=1; the reference is the agreement of the first frame, then follows the frames
+    /// not lost slowly, so a background's own level — plain or cluttered — sets the bar).
+    /// 0 turns the check off.
+    pub lost_silhouette_drop: f32,
     /// Samples along each side of the silhouette check's grid (0: no check).
     pub silhouette_grid: u8,
     /// Slice search parameters.
@@ -60,7 +65,7 @@ impl Default for TrackerConfig {
             converged_mm: 5e-3,
             lost_min_found: 0.3,
             lost_rms_px: 6.0,
-            lost_min_silhouette: 0.0,
+            lost_silhouette_drop: 0.0,
             silhouette_grid: 0,
             features: FeatureConfig::default(),
             estimator: EstimatorConfig::default(),
@@ -149,6 +154,9 @@ pub struct Tracker {
     /// The change of each state over the last frame, scaled by how far that frame's evidence
     /// is trusted; `None` before the first frame and after a reset.
     velocity: Option<[f32; MAX_STATES]>,
+    /// The silhouette agreement a right track has in these images (see
+    /// [`TrackerConfig::lost_silhouette_drop`]); `None` until the first frame.
+    silhouette_reference: Option<f32>,
     free: FreeMask,
     config: TrackerConfig,
     work: Workspace,
@@ -196,6 +204,7 @@ impl Tracker {
             cameras,
             state: Vec::new(),
             velocity: None,
+            silhouette_reference: None,
             free: mask,
             config,
             work: Workspace {
@@ -223,6 +232,7 @@ impl Tracker {
             self.state[..4].copy_from_slice(&u);
         }
         self.velocity = None;
+        self.silhouette_reference = None;
         Ok(())
     }
 
@@ -282,7 +292,13 @@ impl Tracker {
             }
         }
         report.silhouette_agreement = self.silhouette_agreement(frames);
-        report.lost |= report.silhouette_agreement < self.config.lost_min_silhouette;
+        let drop = self.config.lost_silhouette_drop;
+        if drop > 0.0 {
+            let reference = *self
+                .silhouette_reference
+                .get_or_insert(report.silhouette_agreement);
+            report.lost |= report.silhouette_agreement < reference - drop;
+        }
         let found = f32::from(report.features_found);
         let expected = f32::from(report.features_expected).max(1.0);
         report.lost |= found < self.config.lost_min_found * expected
@@ -305,6 +321,12 @@ impl Tracker {
             }
             self.velocity = Some(velocity);
             self.state = q;
+            if !report.lost {
+                if let Some(reference) = self.silhouette_reference.as_mut() {
+                    *reference +=
+                        SILHOUETTE_REFERENCE_RATE * (report.silhouette_agreement - *reference);
+                }
+            }
         } else if motion.hold_when_lost {
             // Keep the last good state; a lost frame's motion is not evidence.
             self.velocity = None;
