@@ -231,8 +231,8 @@ impl Tracker {
         if let Some(u) = crate::quaternion::normalised([state[0], state[1], state[2], state[3]]) {
             self.state[..4].copy_from_slice(&u);
         }
+        // The silhouette reference is the images' level, not the motion's: it stays.
         self.velocity = None;
-        self.silhouette_reference = None;
         Ok(())
     }
 
