@@ -46,6 +46,11 @@ impl PriorWeights {
         }
     }
 
+    /// True when some kind has a prior.
+    pub fn is_on(&self) -> bool {
+        self.quaternion > 0.0 || self.translation > 0.0 || self.joint > 0.0
+    }
+
     /// True when every weight is finite and not negative.
     pub fn is_valid(&self) -> bool {
         [self.quaternion, self.translation, self.joint]

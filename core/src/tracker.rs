@@ -319,6 +319,9 @@ impl Tracker {
                     *v *= trust;
                 }
             }
+            if motion.prior.is_on() {
+                self.observed_part(&mut velocity);
+            }
             self.velocity = Some(velocity);
             self.state = q;
             if !report.lost {
@@ -332,6 +335,28 @@ impl Tracker {
             self.velocity = None;
         }
         Ok(report)
+    }
+
+    /// Keeps only the part of `velocity` the images observed: `(H + P + S)⁻¹ H v`, with `H`
+    /// the last iteration's `JᵀWJ` and `P` the prior. Along directions the images constrain
+    /// (`H` ≫ `P + S`) the velocity stays; along those they do not (a finger seen end-on, the
+    /// split of its bend among its joints) it vanishes, so estimation noise there is never
+    /// extrapolated into the next prediction.
+    fn observed_part(&self, velocity: &mut [f32; MAX_STATES]) {
+        let v = nalgebra::SVector::<f32, MAX_STATES>::from_column_slice(velocity);
+        let mut h_v = self.work.normal.times(self.free, &v);
+        let prior = &self.config.motion.prior;
+        for (i, hv) in h_v.iter_mut().enumerate() {
+            if self.free.contains(i) {
+                *hv -= prior.for_state(i) * v[i];
+            }
+        }
+        let n = self.model.n_states();
+        let conditioning = &self.config.estimator.conditioning;
+        match self.work.normal.solve(n, self.free, conditioning, &h_v) {
+            Some(x) => velocity.copy_from_slice(x.as_slice()),
+            None => *velocity = [0.0; MAX_STATES],
+        }
     }
 
     /// The smallest silhouette agreement over the cameras, with the views of the last
