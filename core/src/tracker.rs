@@ -21,6 +21,10 @@ use crate::model::Model;
 use crate::motion::{velocity_trust, MotionConfig};
 use crate::projection::ProjectedModel;
 
+/// How far beyond a frame's edges (share of its width and height) the palm's origin may
+/// project before a frame is `lost` for having left every camera's view.
+pub const VIEW_SLACK: f32 = 0.25;
+
 /// How fast the silhouette reference follows the frames not lost (share per frame).
 pub const SILHOUETTE_REFERENCE_RATE: f32 = 0.05;
 
@@ -305,6 +309,9 @@ impl Tracker {
             || report.rms_px > self.config.lost_rms_px;
         let finite = q.iter().all(|v| v.is_finite());
         report.lost |= !finite;
+        if finite && self.config.motion.hold_when_lost && !self.palm_in_view(&q) {
+            report.lost = true;
+        }
         let motion = &self.config.motion;
         if finite && !(report.lost && motion.hold_when_lost) {
             let trust = velocity_trust(
@@ -335,6 +342,24 @@ impl Tracker {
             self.velocity = None;
         }
         Ok(report)
+    }
+
+    /// Whether the palm's origin at `q` projects into some camera's frame, grown by
+    /// [`VIEW_SLACK`] of its size on each side: a hand the cameras see cannot be out there.
+    fn palm_in_view(&self, q: &[f32]) -> bool {
+        let Some(&[x, y, z]) = q.get(4..7).and_then(|t| <&[f32; 3]>::try_from(t).ok()) else {
+            return false;
+        };
+        let p = nalgebra::Vector3::new(x, y, z);
+        self.cameras.iter().any(|c| {
+            let (w, h) = (c.width as f32, c.height as f32);
+            c.project(&p).is_some_and(|uv| {
+                uv.x >= -VIEW_SLACK * w
+                    && uv.x <= (1.0 + VIEW_SLACK) * w
+                    && uv.y >= -VIEW_SLACK * h
+                    && uv.y <= (1.0 + VIEW_SLACK) * h
+            })
+        })
     }
 
     /// Keeps only the part of `velocity` the images observed: `(H + P + S)⁻¹ H v`, with `H`
