@@ -308,6 +308,22 @@ impl NormalEquations {
         }
     }
 
+    /// Adds a prior on one state: `weight · (q − centre)²` with `offset = q − centre` (the
+    /// state's units), i.e. `weight` on the diagonal and `weight · offset` on `JᵀWr`. Not a
+    /// residual: it changes neither [`rows`](Self::rows) nor [`rms`](Self::rms). Ignored for a
+    /// state that is not free, or for a non-finite or non-positive weight.
+    pub fn add_prior(&mut self, state: usize, weight: f32, offset: f32, free: FreeMask) {
+        if state >= MAX_STATES
+            || !free.contains(state)
+            || !(weight > 0.0 && weight.is_finite() && offset.is_finite())
+        {
+            return;
+        }
+        let p = position(state);
+        self.diag[p] += weight;
+        self.jtr[p] += weight * offset;
+    }
+
     /// Rows added since the last clear.
     pub fn rows(&self) -> u16 {
         self.rows
@@ -323,17 +339,56 @@ impl NormalEquations {
     }
 
     /// The conditioned Gauss–Newton step `−(JᵀWJ + S)⁻¹ JᵀWr` for the free states (zero for
-    /// the others), or `None` if the system is not positive definite or not finite.
-    ///
-    /// Solved over the free states only, by an `LDLᵀ` factorisation (no square roots) that
-    /// works within each row's envelope: in the joints-then-palm order a joint's row is zero
-    /// left of its chain's first joint, and the factor keeps that profile.
+    /// the others), or `None` if the system is not positive definite or not finite
+    /// ([`solve`](Self::solve)).
     #[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
     pub fn step(
         &self,
         n_states: usize,
         free: FreeMask,
         conditioning: &Conditioning,
+    ) -> Option<SVector<f32, MAX_STATES>> {
+        let mut rhs = SVector::<f32, MAX_STATES>::zeros();
+        for p in 0..MAX_STATES {
+            rhs[state_at(p)] = self.jtr[p];
+        }
+        self.solve(n_states, free, conditioning, &rhs).map(|x| -x)
+    }
+
+    /// `JᵀWJ · x` over the free states (zero for the others); `x` and the result by state.
+    pub fn times(&self, free: FreeMask, x: &SVector<f32, MAX_STATES>) -> SVector<f32, MAX_STATES> {
+        let mut y = SVector::<f32, MAX_STATES>::zeros();
+        for pi in 0..MAX_STATES {
+            let si = state_at(pi);
+            if !free.contains(si) {
+                continue;
+            }
+            y[si] += self.diag[pi] * x[si];
+            for pj in 0..pi {
+                let sj = state_at(pj);
+                if !free.contains(sj) {
+                    continue;
+                }
+                let h = self.below(pi, pj);
+                y[si] += h * x[sj];
+                y[sj] += h * x[si];
+            }
+        }
+        y
+    }
+
+    /// Solves `(JᵀWJ + S) x = rhs` over the free states (zero for the others); `rhs` and `x`
+    /// by state. `None` if the system is not positive definite or the answer not finite.
+    ///
+    /// Solved over the free states only, by an `LDLᵀ` factorisation (no square roots) that
+    /// works within each row's envelope: in the joints-then-palm order a joint's row is zero
+    /// left of its chain's first joint, and the factor keeps that profile.
+    pub fn solve(
+        &self,
+        n_states: usize,
+        free: FreeMask,
+        conditioning: &Conditioning,
+        rhs: &SVector<f32, MAX_STATES>,
     ) -> Option<SVector<f32, MAX_STATES>> {
         // The free states, in storage order: `at[i]` is the position of the i-th.
         let mut at = [0usize; MAX_STATES];
@@ -363,7 +418,7 @@ impl NormalEquations {
                 l[row + j] = self.below(pi, pj);
             }
             d[i] = self.diag[pi] + conditioning.for_state(state_at(pi));
-            b[i] = self.jtr[pi];
+            b[i] = rhs[state_at(pi)];
         }
         // LDLᵀ, row by row: `l` becomes the unit lower factor, `d` the pivots.
         let mut w = [0.0f32; MAX_STATES]; // L[i][k]·D[k] of the row being factored
@@ -412,11 +467,11 @@ impl NormalEquations {
                 *xk -= lik * xi;
             }
         }
-        let mut delta = SVector::<f32, MAX_STATES>::zeros();
-        for (&p, x) in at.iter().zip(&b) {
-            delta[state_at(p)] = -x;
+        let mut x = SVector::<f32, MAX_STATES>::zeros();
+        for (&p, v) in at.iter().zip(&b) {
+            x[state_at(p)] = *v;
         }
-        delta.iter().all(|v| v.is_finite()).then_some(delta)
+        x.iter().all(|v| v.is_finite()).then_some(x)
     }
 }
 

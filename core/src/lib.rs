@@ -15,6 +15,8 @@
 //! - [`frame`]: a borrowed 8-bit frame and bounds-checked sub-pixel sampling.
 //! - [`features`]: the slice edge search of Sec. 4.3.1 with occlusion masking.
 //! - [`estimator`]: residuals, row-by-row normal equations, conditioned Gauss–Newton (Eq. 2.22).
+//! - [`motion`]: the prediction between frames, the prior toward it, what a lost frame keeps.
+//! - [`silhouette`]: how well the projected silhouette agrees with the image (region evidence).
 //! - [`tracker`]: the per-frame loop and its report.
 //! - [`measurement`]: measured axis lines and fingertips at a state, for a stereo host.
 //! - [`protocol`]: the board link's messages and their framing (`docs/protocol.md`).
@@ -35,9 +37,11 @@ pub mod kinematics;
 pub mod measurement;
 pub mod model;
 pub mod model_writer;
+pub mod motion;
 pub mod projection;
 pub mod protocol;
 pub mod quaternion;
+pub mod silhouette;
 pub mod tracker;
 pub mod visibility;
 

@@ -18,7 +18,15 @@ use crate::features::{find_link_features, FeatureConfig, LinkFeatures};
 use crate::frame::{FrameError, FrameView};
 use crate::kinematics::{KinematicsError, Poses};
 use crate::model::Model;
+use crate::motion::{velocity_trust, MotionConfig};
 use crate::projection::ProjectedModel;
+
+/// How far beyond a frame's edges (share of its width and height) the palm's origin may
+/// project before a frame is `lost` for having left every camera's view.
+pub const VIEW_SLACK: f32 = 0.25;
+
+/// How fast the silhouette reference follows the frames not lost (share per frame).
+pub const SILHOUETTE_REFERENCE_RATE: f32 = 0.05;
 
 /// Tracker parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,10 +45,19 @@ pub struct TrackerConfig {
     pub lost_min_found: f32,
     /// The frame is `lost` when the residual RMS exceeds this (px).
     pub lost_rms_px: f32,
+    /// The frame is `lost` when the silhouette agreement falls this far below its reference
+    /// (0..=1; the reference is the agreement of the first frame, then follows the frames
+    /// not lost slowly, so a background's own level — plain or cluttered — sets the bar).
+    /// 0 turns the check off.
+    pub lost_silhouette_drop: f32,
+    /// Samples along each side of the silhouette check's grid (0: no check).
+    pub silhouette_grid: u8,
     /// Slice search parameters.
     pub features: FeatureConfig,
     /// Residual and solve parameters.
     pub estimator: EstimatorConfig,
+    /// Prediction, prior toward it, and what a lost frame keeps.
+    pub motion: MotionConfig,
 }
 
 impl Default for TrackerConfig {
@@ -52,8 +69,11 @@ impl Default for TrackerConfig {
             converged_mm: 5e-3,
             lost_min_found: 0.3,
             lost_rms_px: 6.0,
+            lost_silhouette_drop: 0.0,
+            silhouette_grid: 0,
             features: FeatureConfig::default(),
             estimator: EstimatorConfig::default(),
+            motion: MotionConfig::default(),
         }
     }
 }
@@ -74,6 +94,10 @@ pub struct FrameReport {
     pub links_skipped: u16,
     /// Iterations run.
     pub iterations: u8,
+    /// The silhouette's agreement with the image in the last iteration, the smallest over the
+    /// cameras that could score it (0..=1; [`silhouette`](crate::silhouette)); 1 when none
+    /// could or the check is off.
+    pub silhouette_agreement: f32,
     /// Too few features, or the residual exploded: the state is not to be trusted.
     pub lost: bool,
 }
@@ -131,7 +155,12 @@ pub struct Tracker {
     model: Model,
     cameras: Vec<Camera, MAX_CAMERAS>,
     state: Vec<f32, MAX_STATES>,
-    previous: Option<Vec<f32, MAX_STATES>>,
+    /// The change of each state over the last frame, scaled by how far that frame's evidence
+    /// is trusted; `None` before the first frame and after a reset.
+    velocity: Option<[f32; MAX_STATES]>,
+    /// The silhouette agreement a right track has in these images (see
+    /// [`TrackerConfig::lost_silhouette_drop`]); `None` until the first frame.
+    silhouette_reference: Option<f32>,
     free: FreeMask,
     config: TrackerConfig,
     work: Workspace,
@@ -178,7 +207,8 @@ impl Tracker {
             model,
             cameras,
             state: Vec::new(),
-            previous: None,
+            velocity: None,
+            silhouette_reference: None,
             free: mask,
             config,
             work: Workspace {
@@ -205,7 +235,8 @@ impl Tracker {
         if let Some(u) = crate::quaternion::normalised([state[0], state[1], state[2], state[3]]) {
             self.state[..4].copy_from_slice(&u);
         }
-        self.previous = None;
+        // The silhouette reference is the images' level, not the motion's: it stays.
+        self.velocity = None;
         Ok(())
     }
 
@@ -249,11 +280,12 @@ impl Tracker {
             }
         }
         let start = self.state.clone();
-        let mut q = self.predicted();
+        let predicted = self.predicted();
+        let mut q = predicted.clone();
         let mut report = FrameReport::default();
         self.work.reach = [[f32::INFINITY; MAX_FRAMES]; MAX_CAMERAS];
         for k in 0..self.config.iterations.max(1) {
-            let Some(step) = self.iterate(&q, frames, k > 0, &mut report) else {
+            let Some(step) = self.iterate(&q, &predicted, frames, k > 0, &mut report) else {
                 report.lost = true;
                 break;
             };
@@ -263,26 +295,118 @@ impl Tracker {
                 break;
             }
         }
+        report.silhouette_agreement = self.silhouette_agreement(frames);
+        let drop = self.config.lost_silhouette_drop;
+        if drop > 0.0 {
+            let reference = *self
+                .silhouette_reference
+                .get_or_insert(report.silhouette_agreement);
+            report.lost |= report.silhouette_agreement < reference - drop;
+        }
         let found = f32::from(report.features_found);
         let expected = f32::from(report.features_expected).max(1.0);
         report.lost |= found < self.config.lost_min_found * expected
             || report.rms_px > self.config.lost_rms_px;
-        if q.iter().all(|v| v.is_finite()) {
-            self.previous = Some(start);
-            self.state = q;
-        } else {
+        let finite = q.iter().all(|v| v.is_finite());
+        report.lost |= !finite;
+        if finite && self.config.motion.hold_when_lost && !self.palm_in_view(&q) {
             report.lost = true;
         }
+        let motion = &self.config.motion;
+        if finite && !(report.lost && motion.hold_when_lost) {
+            let trust = velocity_trust(
+                found / expected,
+                self.config.lost_min_found,
+                motion.full_velocity_found,
+            );
+            let mut velocity = [0.0f32; MAX_STATES];
+            for ((v, new), old) in velocity.iter_mut().zip(q.iter()).zip(start.iter()) {
+                *v = *new - *old;
+                if trust < 1.0 {
+                    *v *= trust;
+                }
+            }
+            if motion.prior.is_on() {
+                self.observed_part(&mut velocity);
+            }
+            self.velocity = Some(velocity);
+            self.state = q;
+            if !report.lost {
+                if let Some(reference) = self.silhouette_reference.as_mut() {
+                    *reference +=
+                        SILHOUETTE_REFERENCE_RATE * (report.silhouette_agreement - *reference);
+                }
+            }
+        } else if motion.hold_when_lost {
+            // Keep the last good state; a lost frame's motion is not evidence.
+            self.velocity = None;
+        }
         Ok(report)
+    }
+
+    /// Whether the palm's origin at `q` projects into some camera's frame, grown by
+    /// [`VIEW_SLACK`] of its size on each side: a hand the cameras see cannot be out there.
+    fn palm_in_view(&self, q: &[f32]) -> bool {
+        let Some(&[x, y, z]) = q.get(4..7).and_then(|t| <&[f32; 3]>::try_from(t).ok()) else {
+            return false;
+        };
+        let p = nalgebra::Vector3::new(x, y, z);
+        self.cameras.iter().any(|c| {
+            let (w, h) = (c.width as f32, c.height as f32);
+            c.project(&p).is_some_and(|uv| {
+                uv.x >= -VIEW_SLACK * w
+                    && uv.x <= (1.0 + VIEW_SLACK) * w
+                    && uv.y >= -VIEW_SLACK * h
+                    && uv.y <= (1.0 + VIEW_SLACK) * h
+            })
+        })
+    }
+
+    /// Keeps only the part of `velocity` the images observed: `(H + P + S)⁻¹ H v`, with `H`
+    /// the last iteration's `JᵀWJ` and `P` the prior. Along directions the images constrain
+    /// (`H` ≫ `P + S`) the velocity stays; along those they do not (a finger seen end-on, the
+    /// split of its bend among its joints) it vanishes, so estimation noise there is never
+    /// extrapolated into the next prediction.
+    fn observed_part(&self, velocity: &mut [f32; MAX_STATES]) {
+        let v = nalgebra::SVector::<f32, MAX_STATES>::from_column_slice(velocity);
+        let mut h_v = self.work.normal.times(self.free, &v);
+        let prior = &self.config.motion.prior;
+        for (i, hv) in h_v.iter_mut().enumerate() {
+            if self.free.contains(i) {
+                *hv -= prior.for_state(i) * v[i];
+            }
+        }
+        let n = self.model.n_states();
+        let conditioning = &self.config.estimator.conditioning;
+        match self.work.normal.solve(n, self.free, conditioning, &h_v) {
+            Some(x) => velocity.copy_from_slice(x.as_slice()),
+            None => *velocity = [0.0; MAX_STATES],
+        }
+    }
+
+    /// The smallest silhouette agreement over the cameras, with the views of the last
+    /// iteration (1 when no camera can be scored or the check is off).
+    fn silhouette_agreement(&self, frames: &[FrameView<'_>]) -> f32 {
+        if self.config.silhouette_grid == 0 {
+            return 1.0;
+        }
+        let mut least = 1.0f32;
+        for ((view, camera), frame) in self.work.views.iter().zip(&self.cameras).zip(frames) {
+            let grid = usize::from(self.config.silhouette_grid);
+            if let Some(score) = crate::silhouette::score(view, camera, frame, grid) {
+                least = least.min(score.agreement);
+            }
+        }
+        least
     }
 
     /// The start state of a frame: constant-velocity extrapolation of the free states.
     fn predicted(&self) -> Vec<f32, MAX_STATES> {
         let mut q = self.state.clone();
-        if let (true, Some(prev)) = (self.config.predict, &self.previous) {
+        if let (true, Some(velocity)) = (self.config.predict, &self.velocity) {
             for (i, v) in q.iter_mut().enumerate() {
                 if self.free.contains(i) {
-                    *v += *v - prev[i];
+                    *v += velocity[i];
                     if let Some(limit) = self.model.limit(i) {
                         *v = v.clamp(limit.lo, limit.hi);
                     }
@@ -299,6 +423,7 @@ impl Tracker {
     fn iterate(
         &mut self,
         q: &[f32],
+        predicted: &[f32],
         frames: &[FrameView<'_>],
         refine: bool,
         report: &mut FrameReport,
@@ -369,6 +494,11 @@ impl Tracker {
         report.rms_px = work.normal.rms();
         if work.normal.rows() == 0 {
             return None;
+        }
+        let prior = &config.motion.prior;
+        for (i, (now, centre)) in q.iter().zip(predicted).enumerate() {
+            work.normal
+                .add_prior(i, prior.for_state(i), *now - *centre, self.free);
         }
         work.normal.step(
             self.model.n_states(),

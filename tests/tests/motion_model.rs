@@ -1,0 +1,253 @@
+//! The motion model's mechanisms, each on rendered frames: a lost track holds its last good
+//! state instead of extrapolating; a visibly wrong track is flagged `lost` from the silhouette
+//! within a few frames while a right one is not; a finger seen end-on keeps its joints.
+
+use std::path::Path;
+
+use digiteyes_core::camera::Camera;
+use digiteyes_core::frame::FrameView;
+use digiteyes_core::kinematics::Poses;
+use digiteyes_core::model::{Model, Shape};
+use digiteyes_core::motion::{MotionConfig, PriorWeights};
+use digiteyes_core::tracker::{Tracker, TrackerConfig};
+use digiteyes_host::render::{RenderSettings, Renderer};
+use digiteyes_host::scenarios::{render_scenario, RenderOptions};
+use digiteyes_host::sequence::Sequence;
+use image::GrayImage;
+
+/// The motion model this test judges (the tracker's default once tuned on the sweep).
+fn robust_config() -> TrackerConfig {
+    let mut config = TrackerConfig::default();
+    let mut motion = MotionConfig::PLAIN;
+    motion.hold_when_lost = true;
+    motion.full_velocity_found = 0.7;
+    motion.prior = PriorWeights {
+        quaternion: 0.0,
+        translation: 5.0,
+        joint: 2000.0,
+    };
+    config.motion = motion;
+    config.silhouette_grid = 24;
+    config.lost_silhouette_drop = 0.04;
+    config
+}
+
+fn plain_config() -> TrackerConfig {
+    let mut config = TrackerConfig::default();
+    config.motion = MotionConfig::PLAIN;
+    config
+}
+
+/// A rendered mouse sequence at 320×240.
+fn mouse(dir: &Path, frames: usize) -> Sequence {
+    let seq = dir.join("mouse");
+    let options = RenderOptions {
+        frames: Some(frames),
+        size: Some((320, 240)),
+        supersample: 2,
+        ..RenderOptions::default()
+    };
+    render_scenario("mouse", &seq, &options).unwrap();
+    Sequence::open(&seq).unwrap()
+}
+
+fn tracker(seq: &Sequence, config: TrackerConfig) -> Tracker {
+    let initial: Vec<f32> = seq.initial_state.iter().map(|&v| v as f32).collect();
+    Tracker::new(
+        seq.model.clone(),
+        &seq.cameras,
+        &initial,
+        seq.free.as_deref(),
+        config,
+    )
+    .unwrap()
+}
+
+fn view(image: &GrayImage) -> FrameView<'_> {
+    FrameView::packed(
+        image.as_raw(),
+        image.width() as usize,
+        image.height() as usize,
+    )
+    .unwrap()
+}
+
+/// Mean fingertip reprojection error (px) of `q` against `truth` in `camera`.
+fn fingertip_px(model: &Model, camera: &Camera, q: &[f32], truth: &[f32]) -> f32 {
+    let (pe, pt) = (
+        Poses::compute(model, q).unwrap(),
+        Poses::compute(model, truth).unwrap(),
+    );
+    let tips: Vec<usize> = (0..model.links().len())
+        .filter(|&i| matches!(model.links()[i].shape, Shape::Tip { .. }))
+        .collect();
+    let sum: f32 = tips
+        .iter()
+        .map(|&i| {
+            let a = camera.project(&pe.origin(i).unwrap()).unwrap();
+            let b = camera.project(&pt.origin(i).unwrap()).unwrap();
+            (a - b).norm()
+        })
+        .sum();
+    sum / tips.len() as f32
+}
+
+/// Tracks 12 frames of a moving hand, then 10 frames with nothing in them.
+fn blackout(config: TrackerConfig) -> (Vec<f32>, Vec<(bool, Vec<f32>)>) {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = mouse(dir.path(), 12);
+    let mut t = tracker(&seq, config);
+    for k in 0..12 {
+        let image = seq.read_frame(0, k).unwrap();
+        assert!(!t.track(&[view(&image)]).unwrap().lost, "frame {k} lost");
+    }
+    let good = t.state().to_vec();
+    let empty = GrayImage::from_pixel(320, 240, image::Luma([40]));
+    let after = (0..10)
+        .map(|_| {
+            let report = t.track(&[view(&empty)]).unwrap();
+            (report.lost, t.state().to_vec())
+        })
+        .collect();
+    (good, after)
+}
+
+#[test]
+fn a_lost_track_holds_its_last_good_state() {
+    let (good, after) = blackout(robust_config());
+    for (k, (lost, state)) in after.iter().enumerate() {
+        assert!(lost, "empty frame {k} not flagged lost");
+        assert_eq!(state, &good, "empty frame {k} moved the state");
+    }
+    // The thesis' plain loop keeps extrapolating the last velocity instead.
+    let (good, after) = blackout(plain_config());
+    let (_, last) = after.last().unwrap();
+    assert_ne!(last, &good, "the plain tracker was expected to drift");
+}
+
+#[test]
+fn a_wrong_track_is_flagged_within_five_frames_and_a_right_one_is_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = mouse(dir.path(), 30);
+    let truth = seq.read_truth().unwrap();
+    let truth: Vec<Vec<f32>> = truth
+        .rows
+        .iter()
+        .map(|r| r.iter().map(|&v| v as f32).collect())
+        .collect();
+    let camera = seq.cameras[0];
+    let mut t = tracker(&seq, robust_config());
+    for k in 0..10 {
+        let image = seq.read_frame(0, k).unwrap();
+        let report = t.track(&[view(&image)]).unwrap();
+        assert!(!report.lost, "right frame {k} flagged lost");
+    }
+    // Throw the palm 30 mm sideways and finger 1 into a fist: visibly wrong.
+    let mut wrong = t.state().to_vec();
+    wrong[4] += 30.0;
+    wrong[8] = 1.3;
+    wrong[9] = 1.4;
+    t.reset(&wrong).unwrap();
+    let mut flagged_at = None;
+    for k in 10..30 {
+        let image = seq.read_frame(0, k).unwrap();
+        let report = t.track(&[view(&image)]).unwrap();
+        let error = fingertip_px(&seq.model, &camera, t.state(), &truth[k]);
+        assert!(
+            report.lost || error < 10.0,
+            "frame {k}: {error:.1} px from the truth and not flagged lost"
+        );
+        if report.lost && flagged_at.is_none() {
+            flagged_at = Some(k);
+        }
+    }
+    let flagged_at = flagged_at.expect("the wrong track was never flagged");
+    assert!(flagged_at < 15, "flagged only at frame {flagged_at}");
+}
+
+/// A camera looking down finger 2 from beyond its tip, so the finger is seen end-on.
+fn end_on_camera(model: &Model, q: &[f32]) -> Camera {
+    let poses = Poses::compute(model, q).unwrap();
+    // Finger 2: MCP frame 11, tip frame 14.
+    let base = poses.origin(11).unwrap();
+    let tip = poses.origin(14).unwrap();
+    let axis = (tip - base).normalize();
+    let eye = tip + axis * 400.0 + digiteyes_core::nalgebra::Vector3::new(0.0, 0.0, 30.0);
+    let forward = (base - eye).normalize();
+    let up_hint = digiteyes_core::nalgebra::Vector3::new(0.0, 0.0, 1.0);
+    let right = forward.cross(&up_hint).normalize();
+    let down = forward.cross(&right);
+    let r = digiteyes_core::nalgebra::Matrix3::from_rows(&[
+        right.transpose(),
+        down.transpose(),
+        forward.transpose(),
+    ]);
+    Camera {
+        width: 320,
+        height: 240,
+        fx: 500.0,
+        fy: 500.0,
+        cx: 159.5,
+        cy: 119.5,
+        r,
+        t: -(r * eye),
+    }
+}
+
+#[test]
+fn a_finger_seen_end_on_keeps_its_joints() {
+    let model = Model::hand().unwrap();
+    let mut q = vec![0.0f32; 28];
+    q[0] = 1.0;
+    q[6] = 0.0;
+    (q[12], q[13], q[14]) = (0.15, 0.25, 0.15);
+    let camera = end_on_camera(&model, &q);
+    let settings = RenderSettings {
+        supersample: 2,
+        noise_sigma: 3.0,
+        ..RenderSettings::default()
+    };
+    let renderer = Renderer::new(&model, &camera, settings);
+    let run = |config: TrackerConfig| -> f32 {
+        let mut t = Tracker::new(model.clone(), &[camera], &q, None, config).unwrap();
+        let mut worst = 0.0f32;
+        for k in 0..30 {
+            // The other fingers flex and the palm sways; finger 2 holds still.
+            let mut truth = q.clone();
+            let phase = k as f32 * 0.2;
+            truth[8] = 0.4 + 0.3 * phase.sin();
+            truth[16] = 0.4 + 0.3 * phase.cos();
+            truth[4] = 5.0 * phase.sin();
+            let image = renderer.render(&truth, k).unwrap();
+            t.track(&[view(&image)]).unwrap();
+            for s in 12..=14 {
+                worst = worst.max((t.state()[s] - truth[s]).abs());
+            }
+        }
+        worst
+    };
+    if let Ok(dir) = std::env::var("DIGITEYES_DEBUG_DIR") {
+        renderer
+            .render(&q, 0)
+            .unwrap()
+            .save(format!("{dir}/end_on.png"))
+            .unwrap();
+        println!("plain {:.3}", run(plain_config()));
+        let mut c = robust_config();
+        c.predict = false;
+        println!("robust, no prediction {:.3}", run(c));
+        let mut c = robust_config();
+        c.motion.prior.joint = 8000.0;
+        println!("robust, joint prior 8000 {:.3}", run(c));
+    }
+    let robust = run(robust_config());
+    println!("robust {robust:.3}");
+    assert!(
+        robust < 0.1,
+        "finger 2's joints wandered {robust:.3} rad with the prior"
+    );
+    let plain = run(plain_config());
+    println!(
+        "end-on finger 2: worst joint error {robust:.3} rad with the prior, {plain:.3} without"
+    );
+}
