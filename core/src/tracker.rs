@@ -224,6 +224,28 @@ impl Tracker {
         Ok(tracker)
     }
 
+    /// New cameras and parameters for the frames to come, keeping what the tracker knows of
+    /// the hand: the state, the free states, the motion (the velocity the next prediction
+    /// extrapolates) and the silhouette reference. On an error nothing changes.
+    pub fn reconfigure(
+        &mut self,
+        cameras: &[Camera],
+        config: TrackerConfig,
+    ) -> Result<(), TrackerError> {
+        if cameras.is_empty() {
+            return Err(TrackerError::CameraCount);
+        }
+        let cameras: Vec<Camera, MAX_CAMERAS> =
+            Vec::from_slice(cameras).map_err(|_| TrackerError::CameraCount)?;
+        for c in &cameras {
+            c.validate().map_err(TrackerError::Camera)?;
+        }
+        self.cameras = cameras;
+        self.config = config;
+        self.work.reach = [[f32::INFINITY; MAX_FRAMES]; MAX_CAMERAS];
+        Ok(())
+    }
+
     /// Restarts tracking from `state`, forgetting the motion so far.
     pub fn reset(&mut self, state: &[f32]) -> Result<(), TrackerError> {
         self.work

@@ -86,6 +86,7 @@ fn board_messages() -> std::vec::Vec<BoardMessage> {
                 overflows: u32::MAX,
             },
             capacity_overflows: u32::MAX,
+            stale_chunks: u32::MAX,
         }),
         BoardMessage::Dropped(Dropped {
             frame: 3,
@@ -354,4 +355,42 @@ fn the_largest_messages_nearly_fill_max_message() {
         largest * 10 >= MAX_MESSAGE * 9,
         "{largest} of {MAX_MESSAGE}"
     );
+}
+
+/// `MAX_MESSAGE` counts both delimiters: an encoded frame of exactly 1408 bytes decodes, one
+/// of 1409 is an overflow, counted, and the next frame still decodes.
+#[test]
+fn the_size_limit_counts_both_delimiters() {
+    let mut buf = [0u8; 2 * MAX_MESSAGE];
+    let data = [7u8; 1400];
+    let frame_of = |len: usize, buf: &mut [u8]| -> std::vec::Vec<u8> {
+        let chunk = HostMessage::FrameChunk(FrameChunk {
+            frame: 1,
+            width: 1,
+            height: 1,
+            offset: 0,
+            data: &data[..len],
+        });
+        encode(&chunk, buf).unwrap().to_vec()
+    };
+    let mut at = |total: usize| {
+        (1000..1400)
+            .map(|len| frame_of(len, &mut buf))
+            .find(|f| f.len() == total)
+            .unwrap_or_else(|| panic!("no chunk encodes to {total} bytes"))
+    };
+    let (fits, over) = (at(MAX_MESSAGE), at(MAX_MESSAGE + 1));
+    let mut rx = Rx::new();
+    let mut outcomes = std::vec::Vec::new();
+    let stream: std::vec::Vec<u8> = [&fits[..], &over[..], &fits[..]].concat();
+    let mut rest = &stream[..];
+    while !rest.is_empty() {
+        let (used, out) = rx.feed::<HostMessage>(rest);
+        if let Some(out) = out {
+            outcomes.push(out.map(|_| ()));
+        }
+        rest = &rest[used..];
+    }
+    assert_eq!(outcomes, [Ok(()), Err(LinkError::Overflow), Ok(())]);
+    assert_eq!(rx.counters().overflows, 1);
 }

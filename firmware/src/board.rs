@@ -247,11 +247,12 @@ where
         if configure.camera.frame_bytes() > self.frame.len() {
             return Err(Refusal::FrameTooLarge);
         }
-        if let Some(tracker) = &self.tracker {
-            // Keep estimating from where the board is, with the new camera and parameters.
-            let state: Vec<f32, 32> = Vec::from_slice(tracker.state()).unwrap_or_default();
-            let free = tracker.free().0;
-            self.tracker = Some(self.build_tracker(&camera, config, &state, free)?);
+        if let Some(tracker) = self.tracker.as_mut() {
+            // Keep estimating from where the board is — state, free states and motion — with
+            // the new camera and parameters.
+            tracker
+                .reconfigure(&[camera], config)
+                .map_err(|_| Refusal::BadCamera)?;
         }
         self.setup = Some(Setup {
             camera,
@@ -306,7 +307,7 @@ where
 
     /// Drops and reports a partly uploaded frame: after a new setup its chunks no longer fit.
     fn abandon_upload(&mut self) -> Result<(), S::Error> {
-        match self.upload.abandon() {
+        match self.upload.restart() {
             Some(frame) => self.report_drop(Dropped {
                 frame,
                 reason: DropReason::Superseded,
@@ -329,6 +330,10 @@ where
         }
         match outcome {
             ChunkOutcome::Partial | ChunkOutcome::Ignored => Ok(()),
+            ChunkOutcome::Stale => {
+                self.stats.stale_chunks = self.stats.stale_chunks.saturating_add(1);
+                Ok(())
+            }
             ChunkOutcome::Dropped(dropped) => self.report_drop(dropped),
             ChunkOutcome::Complete { frame, .. } => self.track(frame),
         }

@@ -1,11 +1,21 @@
 //! Frames uploaded over the link, reassembled from `FrameChunk`s into the frame buffer.
 //!
-//! Chunks of a frame must arrive in order with contiguous offsets from 0. Anything else
-//! drops the frame, and every dropped frame is reported exactly once: a gap as
-//! [`DropReason::Incomplete`] when it is seen, a partial frame as [`DropReason::Superseded`]
-//! when a newer frame's chunk arrives. Later chunks of a dropped frame are ignored.
+//! The rule, for any sequence of chunks (`docs/protocol.md` §6): **every frame number is
+//! answered at most once**, and every frame whose chunks start arriving is answered exactly
+//! once — tracked, or dropped with a reason — unless the upload is abandoned by a
+//! `Configure` or `Reset`, which answers it as superseded.
+//!
+//! - Chunks of a frame must arrive in order with contiguous offsets from 0; a gap drops the
+//!   frame as [`DropReason::Incomplete`], a chunk of more than [`MAX_CHUNK`] bytes or past the
+//!   frame's end as [`DropReason::TooLarge`].
+//! - Frame numbers increase: a chunk of a *higher* number than the frame under way supersedes
+//!   it ([`DropReason::Superseded`]) and starts the new frame. A chunk of a number at or below
+//!   the highest one started (a frame already answered, or an older one) is ignored and
+//!   counted (the board's `stale_chunks`): it can neither restart nor supersede anything.
+//! - A `Configure` or `Reset` ([`Upload::restart`]) forgets the numbers: a host may count from
+//!   0 again.
 
-use digiteyes_core::protocol::{DropReason, Dropped, FrameChunk};
+use digiteyes_core::protocol::{DropReason, Dropped, FrameChunk, MAX_CHUNK};
 
 /// What one chunk did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -26,6 +36,9 @@ pub enum ChunkOutcome {
     Dropped(Dropped),
     /// A chunk of a frame already dropped or complete: nothing to do.
     Ignored,
+    /// A chunk of a frame number at or below the highest started, not the frame under way:
+    /// ignored and counted.
+    Stale,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -69,8 +82,9 @@ impl Upload {
         matches!(self.state, Assembly::Receiving { .. })
     }
 
-    /// Forgets any frame under way without reporting it (the caller reports it).
-    pub fn abandon(&mut self) -> Option<u32> {
+    /// Forgets any frame under way without reporting it (the caller reports it), and the
+    /// frame numbers seen: after a `Configure` or `Reset` numbering may start again.
+    pub fn restart(&mut self) -> Option<u32> {
         let was = self.in_progress().then_some(self.frame);
         self.state = Assembly::Idle;
         was
@@ -85,14 +99,18 @@ impl Upload {
         expected: Option<(u16, u16)>,
         buffer: &mut [u8],
     ) -> (Option<Dropped>, ChunkOutcome) {
-        let same_frame = self.state != Assembly::Idle && chunk.frame == self.frame;
-        if same_frame {
+        let started = self.state != Assembly::Idle;
+        if started && chunk.frame == self.frame {
             return (None, self.continue_frame(chunk, buffer));
         }
-        let superseded = self.abandon().map(|frame| Dropped {
-            frame,
+        if started && chunk.frame < self.frame {
+            return (None, ChunkOutcome::Stale);
+        }
+        let superseded = self.in_progress().then_some(Dropped {
+            frame: self.frame,
             reason: DropReason::Superseded,
         });
+        self.state = Assembly::Idle;
         (superseded, self.start_frame(chunk, expected, buffer))
     }
 
@@ -111,7 +129,9 @@ impl Upload {
             Some(size) if size != (chunk.width, chunk.height) => {
                 Some(DropReason::WrongSize(chunk.width, chunk.height))
             }
-            Some(_) if self.bytes() > buffer.len() => Some(DropReason::TooLarge),
+            Some(_) if self.bytes() > buffer.len() || chunk.data.len() > MAX_CHUNK => {
+                Some(DropReason::TooLarge)
+            }
             Some(_) if chunk.offset != 0 => Some(DropReason::Incomplete),
             Some(_) => None,
         };
@@ -131,6 +151,9 @@ impl Upload {
         }
         if usize::try_from(chunk.offset).ok() != Some(received) {
             return self.drop_frame(DropReason::Incomplete);
+        }
+        if chunk.data.len() > MAX_CHUNK {
+            return self.drop_frame(DropReason::TooLarge);
         }
         let end = received + chunk.data.len();
         let Some(slot) = buffer

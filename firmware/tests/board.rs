@@ -573,3 +573,181 @@ fn the_overlay_draws_the_model_over_the_dimmed_frame() {
         .count();
     assert!(dimmed > FRAME_BYTES * 3 / 4);
 }
+
+/// The frame numbers a board answered (`State` or `Dropped`), in order.
+fn answered(messages: &[BoardMessage]) -> Vec<u32> {
+    messages
+        .iter()
+        .filter_map(|m| match m {
+            BoardMessage::State(s) => Some(s.frame),
+            BoardMessage::Dropped(d) => Some(d.frame),
+            _ => None,
+        })
+        .collect()
+}
+
+fn chunk(frame: u32, pixels: &[u8], from: usize, to: usize) -> HostMessage<'_> {
+    HostMessage::FrameChunk(FrameChunk {
+        frame,
+        width: WIDTH as u16,
+        height: HEIGHT as u16,
+        offset: from as u32,
+        data: &pixels[from..to],
+    })
+}
+
+/// The tester's sequence: A's chunks 0–9, one chunk of B, A's chunks 10 to the end. A is
+/// superseded by B and answered once; its later chunks are stale, counted, never answered.
+#[test]
+fn interleaved_chunks_never_answer_a_frame_twice() {
+    let model = Model::hand().unwrap();
+    let q0 = pose(&model, 0.2);
+    let pixels = render(&model, &camera(), &q0);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = ready_board(&mut buffer, &q0);
+    let chunks: Vec<(usize, usize)> = (0..FRAME_BYTES)
+        .step_by(MAX_CHUNK)
+        .map(|from| (from, (from + MAX_CHUNK).min(FRAME_BYTES)))
+        .collect();
+    let (a, b) = (10, 11);
+    for &(from, to) in &chunks[..10] {
+        board.serial_mut().send(&chunk(a, &pixels, from, to));
+    }
+    board.serial_mut().send(&chunk(b, &pixels, 0, MAX_CHUNK));
+    for &(from, to) in &chunks[10..] {
+        board.serial_mut().send(&chunk(a, &pixels, from, to));
+    }
+    // A lower number never supersedes the frame under way either.
+    board.serial_mut().send(&chunk(9, &pixels, 0, MAX_CHUNK));
+    board.poll().unwrap();
+    board
+        .serial_mut()
+        .send_frame(12, WIDTH as u16, HEIGHT as u16, &pixels);
+    board.poll().unwrap();
+    let got = board.serial_mut().received();
+    assert_eq!(answered(&got), [a, b, 12], "{got:?}");
+    let stats = board.stats();
+    assert_eq!(stats.stale_chunks, (chunks.len() - 10) as u32 + 1);
+    assert_eq!(stats.dropped.superseded, 2);
+    assert_eq!(stats.frames, 1);
+}
+
+/// For any order of chunks of any frames (a seeded sweep of 200 random streams), no frame
+/// number is answered twice, and a frame sent whole after the chaos is tracked.
+#[test]
+fn no_order_of_chunks_answers_a_frame_twice() {
+    let model = Model::hand().unwrap();
+    let q0 = pose(&model, 0.2);
+    let pixels = render(&model, &camera(), &q0);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = ready_board(&mut buffer, &q0);
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move |n: u64| {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed % n
+    };
+    let per_frame = FRAME_BYTES.div_ceil(MAX_CHUNK) as u64;
+    for round in 0..200u32 {
+        let base = 100 * round;
+        for _ in 0..12 {
+            let frame = base + next(5) as u32;
+            let k = next(per_frame) as usize;
+            let from = k * MAX_CHUNK;
+            let to = (from + MAX_CHUNK).min(FRAME_BYTES);
+            board.serial_mut().send(&chunk(frame, &pixels, from, to));
+        }
+        board.poll().unwrap();
+        let got = answered(&board.serial_mut().received());
+        let mut seen = std::collections::HashSet::new();
+        for frame in &got {
+            assert!(
+                seen.insert(*frame),
+                "round {round}: frame {frame} answered twice: {got:?}"
+            );
+        }
+        // Whatever is under way is superseded by the next round's higher numbers: answered
+        // once in that round, never again.
+    }
+    board
+        .serial_mut()
+        .send_frame(1_000_000, WIDTH as u16, HEIGHT as u16, &pixels);
+    board.poll().unwrap();
+    let got = board.serial_mut().received();
+    assert!(
+        got.iter()
+            .any(|m| matches!(m, BoardMessage::State(s) if s.frame == 1_000_000)),
+        "{got:?}"
+    );
+}
+
+/// `MAX_CHUNK` is enforced: a 1025-byte chunk drops its frame as too large, counted.
+#[test]
+fn a_chunk_over_max_chunk_drops_its_frame() {
+    let model = Model::hand().unwrap();
+    let q0 = pose(&model, 0.2);
+    let pixels = render(&model, &camera(), &q0);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = ready_board(&mut buffer, &q0);
+    board
+        .serial_mut()
+        .send(&chunk(1, &pixels, 0, MAX_CHUNK + 1));
+    board.serial_mut().send(&chunk(2, &pixels, 0, MAX_CHUNK));
+    board
+        .serial_mut()
+        .send(&chunk(2, &pixels, MAX_CHUNK, 2 * MAX_CHUNK + 1));
+    board.poll().unwrap();
+    let got = board.serial_mut().received();
+    let drops: Vec<(u32, DropReason)> = got
+        .iter()
+        .filter_map(|m| match m {
+            BoardMessage::Dropped(d) => Some((d.frame, d.reason)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        drops,
+        [(1, DropReason::TooLarge), (2, DropReason::TooLarge)],
+        "{got:?}"
+    );
+    assert_eq!(board.stats().dropped.too_large, 2);
+}
+
+/// A second `Configure` keeps the state, the free states and the motion: the next frame's
+/// state is bit-equal to that of a board that was not reconfigured.
+#[test]
+fn a_second_configure_keeps_the_motion() {
+    let model = Model::hand().unwrap();
+    let cam = camera();
+    let q0 = pose(&model, 0.2);
+    let frames: Vec<Vec<u8>> = [0.26f32, 0.32, 0.38, 0.44]
+        .iter()
+        .map(|&bend| render(&model, &cam, &pose(&model, bend)))
+        .collect();
+    let last_state = |reconfigure: bool| {
+        let mut buffer = vec![0u8; FRAME_BYTES];
+        let mut board = ready_board(&mut buffer, &q0);
+        for (n, pixels) in frames.iter().enumerate() {
+            if reconfigure && n == 3 {
+                board.serial_mut().send(&configure(0, 0));
+            }
+            board
+                .serial_mut()
+                .send_frame(n as u32, WIDTH as u16, HEIGHT as u16, pixels);
+            board.poll().unwrap();
+        }
+        let got = board.serial_mut().received();
+        if reconfigure {
+            assert!(
+                got.contains(&BoardMessage::Ack(Command::Configure)),
+                "{got:?}"
+            );
+        }
+        match got.last() {
+            Some(BoardMessage::State(s)) => s.q.clone(),
+            other => panic!("{other:?}"),
+        }
+    };
+    assert_eq!(last_state(true), last_state(false));
+}

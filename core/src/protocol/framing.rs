@@ -70,7 +70,8 @@ pub fn max_encoded_len<T: Serialize + ?Sized>(message: &T) -> Option<usize> {
     Some(raw + raw / 254 + 1 + 2)
 }
 
-/// Splits a byte stream into frames and decodes them, with a receive buffer of `N` bytes.
+/// Splits a byte stream into frames and decodes them, accepting frames of at most `N` bytes
+/// with both delimiters (`N − 2` between them).
 ///
 /// Garbage between frames is discarded at the next delimiter and counted; a corrupted frame
 /// costs that frame only, so the stream resynchronises by the next one.
@@ -125,7 +126,8 @@ impl<const N: usize> Decoder<N> {
     ) -> (usize, Option<Result<T, LinkError>>) {
         for (i, &byte) in input.iter().enumerate() {
             if byte != 0 {
-                match self.buf.get_mut(self.len) {
+                // `N` counts both delimiters: at most `N − 2` bytes between them.
+                match self.buf.get_mut(self.len).filter(|_| self.len + 2 < N) {
                     Some(slot) => {
                         *slot = byte;
                         self.len += 1;

@@ -222,6 +222,9 @@ pub struct Stats {
     pub link: LinkCounters,
     /// Capacity overflows: a message too large for the transmit buffer, features truncated.
     pub capacity_overflows: u32,
+    /// `FrameChunk`s ignored because their frame number was below the frame under way (an
+    /// older frame, or one already answered): never answered again (protocol version 2).
+    pub stale_chunks: u32,
 }
 
 /// Why a frame was not tracked.

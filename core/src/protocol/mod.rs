@@ -17,19 +17,22 @@ mod framing;
 mod messages;
 mod params;
 
-pub use digest::model_digest;
+pub use digest::{canonical_form, model_digest};
 pub use framing::{encode, max_encoded_len, Decoder, EncodeError, LinkError};
 pub use messages::*;
 pub use params::{BadParameter, CameraParams, TrackerParams, WireResidual, WireRobust};
 
 /// The protocol version in [`Hello`]; it rises whenever a message's layout changes.
-pub const PROTOCOL_VERSION: u8 = 1;
+/// Version 2: `Stats` gained `stale_chunks`, and the model digest is computed over the
+/// canonical form of `docs/protocol.md` §7 (version 1 digested `write_dh`'s text).
+pub const PROTOCOL_VERSION: u8 = 2;
 
 /// Largest `FrameChunk` payload (bytes).
 pub const MAX_CHUNK: usize = 1024;
 
-/// Largest encoded message either side sends (bytes, delimiters included), so the size of
-/// every receive and transmit buffer: the largest are a `Features` naming all
+/// Largest encoded message either side sends or accepts (bytes, both zero delimiters
+/// included: at most `MAX_MESSAGE − 2` COBS bytes between them), so the size of every receive
+/// and transmit buffer: the largest are a `Features` naming all
 /// [`MAX_FRAMES`](crate::config::MAX_FRAMES) links (1,315 bytes) and a full `FrameChunk`
 /// (about 1,050 bytes); `tests/protocol.rs` checks both fit.
 pub const MAX_MESSAGE: usize = 1408;

@@ -11,7 +11,7 @@ use crate::config::{MAX_SLICES_PER_LINK, MAX_WINDOW};
 use crate::estimator::{Conditioning, ResidualKind, Robust};
 use crate::tracker::TrackerConfig;
 
-/// A pinhole camera (sequence-format.md): `p_c = R · p_w + t`, `u = fx · x/z + cx`.
+/// A pinhole camera (`docs/sequence-format.md`): `p_c = R · p_w + t`, `u = fx · x/z + cx`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct CameraParams {

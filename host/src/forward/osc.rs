@@ -258,6 +258,7 @@ mod tests {
                 ..LinkCounters::default()
             },
             capacity_overflows: 0,
+            stale_chunks: 0,
         };
         let OscPacket::Message(m) = decode(&encode(&stats_message(&stats)).unwrap()) else {
             panic!("not a message");

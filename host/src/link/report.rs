@@ -108,7 +108,7 @@ impl fmt::Display for LinkReport {
                     f,
                     "  board{}: {} frames tracked, {} iterations, {} lost; dropped: {} \
                      incomplete, {} wrong size, {} too large, {} not ready, {} superseded, {} \
-                     tracker error; {} bad frames, {} capacity overflows",
+                     tracker error; {} bad frames, {} capacity overflows, {} stale chunks",
                     if pong {
                         ""
                     } else {
@@ -124,7 +124,8 @@ impl fmt::Display for LinkReport {
                     d.superseded,
                     d.tracker_error,
                     stats.bad_frames,
-                    stats.capacity_overflows
+                    stats.capacity_overflows,
+                    stats.stale_chunks
                 )?;
                 write!(f, "  board receiver: {}", counters(&stats.link))
             }

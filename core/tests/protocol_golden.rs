@@ -1,0 +1,309 @@
+//! The wire format pinned to bytes: one golden frame per message type, both directions,
+//! as `docs/protocol.md` specifies them. Encoding each fixed message must give exactly these
+//! bytes (delimiters, COBS, postcard body, CRC-32), and decoding them must give the message
+//! back, so reordering a field, changing an integer's width or a variant's index fails here
+//! even though a round trip would still pass. Two of them (`Ping`, `Dropped`) are worked
+//! through byte by byte in the spec; the model digest's worked example is checked too.
+
+use digiteyes_core::model::Model;
+use digiteyes_core::protocol::*;
+
+fn host_messages(data: &[u8]) -> Vec<(&'static str, HostMessage<'_>)> {
+    vec![
+        (
+            "Reset",
+            HostMessage::Reset(Reset {
+                q: heapless::Vec::from_slice(&[1.0, 0.0, 0.0, 0.0, 5.0, -2.5, 400.0]).unwrap(),
+                free: 0b111_0000,
+            }),
+        ),
+        (
+            "Configure",
+            HostMessage::Configure(Configure {
+                camera: CameraParams {
+                    width: 320,
+                    height: 240,
+                    intrinsics: [500.0, 500.0, 159.5, 119.5],
+                    r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+                    t: [0.0, 0.0, 600.0],
+                },
+                tracker: TrackerParams::default(),
+                features_every: 0,
+                stats_every: 30,
+            }),
+        ),
+        (
+            "FrameChunk",
+            HostMessage::FrameChunk(FrameChunk {
+                frame: 7,
+                width: 4,
+                height: 2,
+                offset: 0,
+                data,
+            }),
+        ),
+        ("Ping", HostMessage::Ping(0x0102_0304)),
+    ]
+}
+
+fn board_messages() -> Vec<(&'static str, BoardMessage)> {
+    let mut links = heapless::Vec::new();
+    links
+        .push(LinkMeasurement {
+            link: 4,
+            axis: Some(AxisLine {
+                point: [10.0, 20.0],
+                direction: [0.6, 0.8],
+            }),
+            tip: None,
+        })
+        .unwrap();
+    links
+        .push(LinkMeasurement {
+            link: 6,
+            axis: None,
+            tip: Some([12.5, 30.0]),
+        })
+        .unwrap();
+    vec![
+        (
+            "Hello",
+            BoardMessage::Hello(Hello {
+                version: 2,
+                board: heapless::String::try_from("qemu-m7").unwrap(),
+                model_digest: 0xd4f6_1ba4,
+                clock_hz: 25_000_000,
+                capacities: Capacities {
+                    states: 28,
+                    max_states: 32,
+                    max_frames: 48,
+                    max_frame_bytes: 307_200,
+                    max_chunk: 1024,
+                    max_message: 1408,
+                },
+            }),
+        ),
+        (
+            "State",
+            BoardMessage::State(State {
+                frame: 7,
+                timestamp: 1000,
+                q: heapless::Vec::from_slice(&[1.0, 0.0, 0.5]).unwrap(),
+                rms_px: 0.25,
+                lost: false,
+                features_found: 10,
+                features_expected: 12,
+                iterations: 3,
+                track_ticks: 4096,
+            }),
+        ),
+        (
+            "Features",
+            BoardMessage::Features(Features {
+                frame: 7,
+                camera: 0,
+                links,
+            }),
+        ),
+        (
+            "Stats",
+            BoardMessage::Stats(Stats {
+                frames: 1,
+                iterations: 2,
+                lost: 3,
+                dropped: DropCounts {
+                    incomplete: 4,
+                    wrong_size: 5,
+                    too_large: 6,
+                    not_ready: 7,
+                    superseded: 8,
+                    tracker_error: 9,
+                },
+                bad_frames: 10,
+                link: LinkCounters {
+                    messages: 300,
+                    crc_errors: 11,
+                    framing_errors: 12,
+                    decode_errors: 13,
+                    overflows: 14,
+                },
+                capacity_overflows: 15,
+                stale_chunks: 16,
+            }),
+        ),
+        (
+            "Dropped",
+            BoardMessage::Dropped(Dropped {
+                frame: 9,
+                reason: DropReason::WrongSize(320, 240),
+            }),
+        ),
+        ("Ack", BoardMessage::Ack(Command::Reset)),
+        (
+            "Nak",
+            BoardMessage::Nak(Command::Configure, Refusal::BadParameters),
+        ),
+        ("Pong", BoardMessage::Pong(0x0102_0304)),
+    ]
+}
+
+/// The pixels of the golden `FrameChunk` (a zero byte among them, to exercise COBS).
+const PIXELS: [u8; 8] = [1, 2, 3, 0, 255, 4, 5, 6];
+
+fn golden_host(name: &str) -> &'static [u8] {
+    match name {
+        "Reset" => &[
+            0x00, 0x01, 0x02, 0x07, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01,
+            0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x03, 0xa0, 0x40, 0x01, 0x03, 0x20, 0xc0,
+            0x01, 0x08, 0xc8, 0x43, 0x70, 0x72, 0xd8, 0x0f, 0x4f, 0x00,
+        ],
+        "Configure" => &[
+            0x00, 0x06, 0x01, 0xc0, 0x02, 0xf0, 0x01, 0x01, 0x03, 0xfa, 0x43, 0x01, 0x03, 0xfa,
+            0x43, 0x04, 0x80, 0x1f, 0x43, 0x01, 0x03, 0xef, 0x42, 0x01, 0x03, 0x80, 0x3f, 0x01,
+            0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x03, 0x80,
+            0x3f, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01,
+            0x03, 0x80, 0x3f, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x07, 0x16,
+            0x44, 0x08, 0x01, 0x05, 0x14, 0x01, 0x05, 0x80, 0x40, 0x02, 0x01, 0x01, 0x01, 0x02,
+            0x40, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x07, 0x7a, 0x44, 0x9a,
+            0x99, 0x99, 0x3e, 0x01, 0x03, 0xc0, 0x40, 0x06, 0x1e, 0xb8, 0x61, 0x4c, 0x83, 0x00,
+        ],
+        "FrameChunk" => &[
+            0x00, 0x05, 0x02, 0x07, 0x04, 0x02, 0x05, 0x08, 0x01, 0x02, 0x03, 0x09, 0xff, 0x04,
+            0x05, 0x06, 0xd0, 0x07, 0xad, 0x3d, 0x00,
+        ],
+        "Ping" => &[
+            0x00, 0x0a, 0x03, 0x84, 0x86, 0x88, 0x08, 0xe2, 0x51, 0x80, 0xfb, 0x00,
+        ],
+        _ => unreachable!("no golden frame for {name}"),
+    }
+}
+
+fn golden_board(name: &str) -> &'static [u8] {
+    match name {
+        "Hello" => &[
+            0x00, 0x01, 0x21, 0x02, 0x07, 0x71, 0x65, 0x6d, 0x75, 0x2d, 0x6d, 0x37, 0xa4, 0xb7,
+            0xd8, 0xa7, 0x0d, 0xc0, 0xf0, 0xf5, 0x0b, 0x1c, 0x20, 0x30, 0x80, 0xe0, 0x12, 0x80,
+            0x08, 0x80, 0x0b, 0x97, 0x0c, 0x65, 0xbf, 0x00,
+        ],
+        "State" => &[
+            0x00, 0x06, 0x01, 0x07, 0xe8, 0x07, 0x03, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x01, 0x01,
+            0x01, 0x01, 0x01, 0x02, 0x3f, 0x01, 0x03, 0x80, 0x3e, 0x0a, 0x0a, 0x0c, 0x03, 0x80,
+            0x20, 0x8f, 0x95, 0x7a, 0x6e, 0x00,
+        ],
+        "Features" => &[
+            0x00, 0x03, 0x02, 0x07, 0x04, 0x02, 0x04, 0x01, 0x01, 0x03, 0x20, 0x41, 0x01, 0x0b,
+            0xa0, 0x41, 0x9a, 0x99, 0x19, 0x3f, 0xcd, 0xcc, 0x4c, 0x3f, 0x02, 0x06, 0x02, 0x01,
+            0x01, 0x03, 0x48, 0x41, 0x01, 0x07, 0xf0, 0x41, 0xfb, 0x65, 0x0f, 0x05, 0x00,
+        ],
+        "Stats" => &[
+            0x00, 0x18, 0x03, 0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0x08, 0x09, 0x0a, 0xac,
+            0x02, 0x0b, 0x0c, 0x0d, 0x0e, 0x0f, 0x10, 0x0b, 0xa7, 0x33, 0xc5, 0x00,
+        ],
+        "Dropped" => &[
+            0x00, 0x0c, 0x04, 0x09, 0x01, 0xc0, 0x02, 0xf0, 0x01, 0x56, 0x68, 0x3e, 0x65, 0x00,
+        ],
+        "Ack" => &[0x00, 0x02, 0x05, 0x05, 0xba, 0xe6, 0xae, 0x3c, 0x00],
+        "Nak" => &[0x00, 0x08, 0x06, 0x01, 0x01, 0x77, 0xa4, 0xd0, 0x95, 0x00],
+        "Pong" => &[
+            0x00, 0x08, 0x07, 0x84, 0x86, 0x88, 0x08, 0x22, 0xf7, 0x02, 0x0e, 0x00,
+        ],
+        _ => unreachable!("no golden frame for {name}"),
+    }
+}
+
+#[test]
+fn every_host_message_encodes_to_its_golden_bytes_and_back() {
+    let mut buf = [0u8; MAX_MESSAGE];
+    let messages = host_messages(&PIXELS);
+    assert_eq!(
+        messages.len(),
+        4,
+        "one golden frame per HostMessage variant"
+    );
+    for (name, message) in messages {
+        let golden = golden_host(name);
+        assert_eq!(encode(&message, &mut buf).unwrap(), golden, "{name}");
+        let mut rx = Decoder::<MAX_MESSAGE>::new();
+        let (used, decoded) = rx.feed::<HostMessage>(golden);
+        assert_eq!(used, golden.len(), "{name}: one frame, all of it");
+        assert_eq!(decoded.unwrap().unwrap(), message, "{name}");
+    }
+}
+
+#[test]
+fn every_board_message_encodes_to_its_golden_bytes_and_back() {
+    let mut buf = [0u8; MAX_MESSAGE];
+    let messages = board_messages();
+    assert_eq!(
+        messages.len(),
+        8,
+        "one golden frame per BoardMessage variant"
+    );
+    for (name, message) in messages {
+        let golden = golden_board(name);
+        assert_eq!(encode(&message, &mut buf).unwrap(), golden, "{name}");
+        let mut rx = Decoder::<MAX_MESSAGE>::new();
+        let mut decoded = None;
+        let mut rest = golden;
+        while decoded.is_none() && !rest.is_empty() {
+            let (used, out) = rx.feed::<BoardMessage>(rest);
+            decoded = out;
+            rest = &rest[used..];
+        }
+        assert_eq!(decoded.unwrap().unwrap(), message, "{name}");
+    }
+}
+
+/// The spec's worked example of the model digest (§7), computed from the bytes written out
+/// there, independently of the code that produces the canonical form.
+#[test]
+fn the_digest_of_the_worked_example_is_the_crc_of_the_bytes_in_the_spec() {
+    let tiny = "0 palm base 0 0 0 box 10 20 5 1\n\
+                1 f q7 0 30 0 cyl 5 2\n\
+                2 t 0 0 0 0 tip 4 -\n\
+                limit q7 0 1.5\n";
+    let f = |v: f32| v.to_le_bytes();
+    let mut bytes = vec![3u8];
+    // Frame 0: base; d, a, alpha = 0; box 10 20 5 at the palm's default centre; next [1].
+    bytes.push(0);
+    for v in [0.0, 0.0, 0.0] {
+        bytes.extend(f(v));
+    }
+    bytes.push(3);
+    for v in [10.0, 20.0, 5.0, 2.5, -9.0, 0.0] {
+        bytes.extend(f(v));
+    }
+    bytes.extend([1, 1]);
+    // Frame 1: q7; d 0, a 30, alpha 0; cyl 5; next [2].
+    bytes.extend([1, 7]);
+    for v in [0.0, 30.0, 0.0] {
+        bytes.extend(f(v));
+    }
+    bytes.push(1);
+    bytes.extend(f(5.0));
+    bytes.extend([1, 2]);
+    // Frame 2: constant theta 0; d, a, alpha 0; tip 4; no next.
+    bytes.push(2);
+    for v in [0.0, 0.0, 0.0, 0.0] {
+        bytes.extend(f(v));
+    }
+    bytes.push(2);
+    bytes.extend(f(4.0));
+    bytes.push(0);
+    // One limit: q7 in [0, 1.5].
+    bytes.extend([1, 7]);
+    bytes.extend(f(0.0));
+    bytes.extend(f(1.5));
+    assert_eq!(bytes.len(), 95);
+    let crc = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC).checksum(&bytes);
+    assert_eq!(crc, 0x1800_0900, "the spec's value");
+    let model = Model::parse(tiny).unwrap();
+    assert_eq!(model_digest(&model), crc);
+    let mut canonical = Vec::new();
+    canonical_form(&model, |b| canonical.extend_from_slice(b));
+    assert_eq!(canonical, bytes);
+    // The built-in hand, as the spec gives it; names and number spellings do not count.
+    assert_eq!(model_digest(&Model::hand().unwrap()), 0xd4f6_1ba4);
+    let respelled = tiny.replace("0 30 0", "0 3e1 0").replace(" f ", " finger ");
+    assert_eq!(model_digest(&Model::parse(&respelled).unwrap()), crc);
+}
