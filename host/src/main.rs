@@ -16,7 +16,9 @@ use digiteyes_host::forward::one_euro::{self, Smoothing};
 use digiteyes_host::forward::parse_forward;
 use digiteyes_host::link::Link;
 use digiteyes_host::listen::{listen, ListenOptions};
-use digiteyes_host::scenarios::{render_scenario, RenderOptions, DEFAULT_FRAMES, NAMES};
+use digiteyes_host::scenarios::{
+    render_scenario, RenderOptions, DEFAULT_FRAMES, NAMES, RANDOM_NAMES,
+};
 use digiteyes_host::stream::{stream_camera, DEFAULT_BAUD};
 use digiteyes_host::ui::board_tap::ui_tap;
 use digiteyes_host::ui::{attach_mouse, run_ui, Hub, UiOptions, UiServer, UiSource, DEFAULT_BIND};
@@ -53,10 +55,18 @@ enum Command {
     ///   fullhand-mono    the same motion, first camera only
     ///   fast             the mouse motion at 20 px/frame fingertip speed (peak)
     ///   clutter          the mouse motion over a cluttered background, noise σ 8
+    ///   random-mono      a random rig from --seed: one camera anywhere on the upper
+    ///                    hemisphere (elevation 20-90°, any azimuth, 350-1500 mm, hand
+    ///                    120-350 px wide) and a random whole-hand motion through fists,
+    ///                    crossing fingers and end-on fingers (docs/robustness.md)
+    ///   random-stereo    the same with a second camera 150-600 mm beside the first
+    ///   thesis-stereo    the thesis' stereo rig: two cameras behind the wrist, 60° up
     #[command(verbatim_doc_comment)]
     Render {
         /// Scenario name (see above).
-        #[arg(value_parser = clap::builder::PossibleValuesParser::new(NAMES))]
+        #[arg(value_parser = clap::builder::PossibleValuesParser::new(
+            NAMES.iter().chain(RANDOM_NAMES.iter()).copied()
+        ))]
         scenario: String,
         /// Output sequence folder (created if missing; existing files are overwritten).
         outdir: PathBuf,

@@ -10,6 +10,7 @@
 pub mod cameras;
 pub mod catalogue;
 pub mod measure;
+pub mod random;
 pub mod trajectory;
 
 use std::path::Path;
@@ -21,6 +22,7 @@ use digiteyes_core::model::Model;
 use crate::render::{Background, RenderSettings, Renderer};
 use crate::sequence::{self, CameraFile, SequenceFile, BUILTIN_HAND};
 pub use catalogue::{scenario, Scenario, NAMES};
+pub use random::RANDOM_NAMES;
 use trajectory::Motion;
 
 /// Frames rendered unless asked otherwise.
@@ -92,11 +94,31 @@ pub struct Generated {
     pub amplitude_factor: f64,
 }
 
-/// Draws the trajectory of scenario `name` and everything else needed to render it.
+/// Times a random rig whose motion leaves its view is widened (focal length × 0.8 each).
+pub const MAX_ZOOM_OUTS: usize = 6;
+
+/// Draws the trajectory of scenario `name` and everything else needed to render it. The
+/// random rigs ([`random`]) are drawn from `opts.seed`; one whose hand would leave the view is
+/// widened until it does not.
 pub fn generate(name: &str, opts: &RenderOptions) -> Result<Generated> {
+    let Some(drawn) = random::by_name(name, opts.seed) else {
+        return generate_from(catalogue::scenario(name)?, opts);
+    };
+    let mut last = None;
+    for k in 0..=MAX_ZOOM_OUTS {
+        match generate_from(random::zoomed(&drawn, 0.8f64.powi(k as i32)), opts) {
+            Ok(generated) => return Ok(generated),
+            Err(e) => last = Some(e),
+        }
+    }
+    Err(last.unwrap_or_else(|| anyhow::anyhow!("scenario {name}: no view fits")))
+}
+
+/// [`generate`] for a scenario already defined.
+pub fn generate_from(scenario: Scenario, opts: &RenderOptions) -> Result<Generated> {
     let frames = opts.frames.unwrap_or(DEFAULT_FRAMES);
     ensure!(frames > 0, "at least one frame is needed");
-    let scenario = catalogue::scenario(name)?;
+    let name = scenario.name;
     let model = Model::hand().map_err(|e| anyhow::anyhow!("built-in hand model: {e}"))?;
     let amplitudes = within_limits(&model, &scenario.base, &scenario.amplitudes);
     // Speed is set in the first camera at the default size, so the motion depends neither on
