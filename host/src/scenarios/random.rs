@@ -126,7 +126,7 @@ fn camera_at(
 
 /// The random scenario of `seed`, with one camera or two.
 pub fn random_scenario(seed: u64, stereo: bool) -> Scenario {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5eed_0f_4a4d_u64);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x005e_ed0f_4a4d_u64);
     // A mid-range pose, and amplitudes across most of each joint's range.
     let mut base = palm_down([0.0; 3], 0.0);
     let mut amplitudes = vec![
