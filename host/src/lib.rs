@@ -31,6 +31,7 @@
 #![warn(missing_docs)]
 
 pub mod atomic_file;
+pub mod bench;
 pub mod cli_values;
 pub mod demo;
 pub mod eval;

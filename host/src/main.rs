@@ -376,6 +376,9 @@ enum Command {
         #[arg(long, value_name = "S", value_parser = cli_values::positive_seconds)]
         seconds: Option<f64>,
     },
+    /// Measure the tracker beyond what a test should: `bench robustness`.
+    #[command(subcommand)]
+    Bench(BenchCommand),
     /// Render the `mouse` scenario, stream it to a simulated board, evaluate, report, show.
     ///
     /// The rendered camera's frames go to a simulated Linux board (the firmware loop on a
@@ -398,6 +401,20 @@ enum Command {
         #[arg(long, value_name = "S", value_parser = cli_values::seconds_or_zero)]
         ui_seconds: Option<f64>,
     },
+}
+
+/// What `digiteyes bench` measures.
+#[derive(Subcommand, Debug)]
+enum BenchCommand {
+    /// Render and track a randomised sweep of rigs and motions and print the distribution.
+    ///
+    /// Odd seeds are `random-mono`, even ones `random-stereo` (see `render --help`). Per
+    /// group (mono, stereo, all): median and 10th-percentile track life, the share of seeds
+    /// at >= 95 %, median fingertip px, joint RMS deg, palm deg and mm, the lost flag's
+    /// precision and recall against frames truly lost (fingertips > 20 px at 640 px wide or
+    /// palm > 30 mm), non-finite states, frames with the palm > 100 mm away and not flagged,
+    /// and tracker ms per frame. See docs/robustness.md.
+    Robustness(digiteyes_host::bench::robustness::RobustnessArgs),
 }
 
 /// The serial port options of `stream` and `listen`.
@@ -662,6 +679,10 @@ fn run(cli: Cli) -> Result<()> {
                 duration: seconds.map(cli_values::duration),
             };
             run_ui(&options, &mut std::io::stdout())?;
+        }
+        Command::Bench(BenchCommand::Robustness(args)) => {
+            let sweep = digiteyes_host::bench::robustness::run(&args)?;
+            print!("{sweep}");
         }
         Command::Demo {
             frames,

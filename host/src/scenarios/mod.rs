@@ -94,8 +94,11 @@ pub struct Generated {
     pub amplitude_factor: f64,
 }
 
-/// Times a random rig whose motion leaves its view is widened (focal length × 0.8 each).
-pub const MAX_ZOOM_OUTS: usize = 6;
+/// Times a random rig whose motion leaves its view is widened (focal length ×
+/// [`ZOOM_OUT`] each).
+pub const MAX_ZOOM_OUTS: usize = 4;
+/// The focal length's factor per widening.
+pub const ZOOM_OUT: f64 = 0.9;
 
 /// Draws the trajectory of scenario `name` and everything else needed to render it. The
 /// random rigs ([`random`]) are drawn from `opts.seed`; one whose hand would leave the view is
@@ -106,7 +109,7 @@ pub fn generate(name: &str, opts: &RenderOptions) -> Result<Generated> {
     };
     let mut last = None;
     for k in 0..=MAX_ZOOM_OUTS {
-        match generate_from(random::zoomed(&drawn, 0.8f64.powi(k as i32)), opts) {
+        match generate_from(random::zoomed(&drawn, ZOOM_OUT.powi(k as i32)), opts) {
             Ok(generated) => return Ok(generated),
             Err(e) => last = Some(e),
         }

@@ -1,0 +1,117 @@
+//! The robustness sweep's instruments: the random rigs and motions cover the ranges they
+//! claim, deterministically, within the joints' limits and the view; the benchmark runs a
+//! tiny sweep end to end.
+
+use digiteyes_core::model::Model;
+use digiteyes_host::bench::robustness::{run, Motion, RobustnessArgs};
+use digiteyes_host::scenarios::{generate, RenderOptions};
+
+fn options(seed: u64) -> RenderOptions {
+    RenderOptions {
+        seed,
+        frames: Some(60),
+        size: Some((160, 120)),
+        supersample: 1,
+        ..RenderOptions::default()
+    }
+}
+
+/// Camera `c`'s centre in the world (mm): `−Rᵀ t`.
+fn eye(file: &digiteyes_host::sequence::CameraFile) -> [f64; 3] {
+    let (r, t) = (file.r, file.t);
+    [0, 1, 2].map(|j| -(r[0][j] * t[0] + r[1][j] * t[1] + r[2][j] * t[2]))
+}
+
+#[test]
+fn random_rigs_are_seeded_in_view_within_limits_and_cover_the_hemisphere() {
+    let model = Model::hand().unwrap();
+    let (mut elevations, mut quadrants, mut distances) = (Vec::new(), [false; 4], Vec::new());
+    for seed in 1..=40u64 {
+        let name = if seed % 2 == 0 {
+            "random-stereo"
+        } else {
+            "random-mono"
+        };
+        let a = generate(name, &options(seed)).unwrap();
+        let b = generate(name, &options(seed)).unwrap();
+        assert_eq!(a.truth, b.truth, "seed {seed} not deterministic");
+        assert_eq!(a.file.cameras, b.file.cameras);
+        assert_eq!(a.cameras.len(), if seed % 2 == 0 { 2 } else { 1 });
+        assert_eq!(a.file.free.as_ref().unwrap().len(), 28);
+        for row in &a.truth {
+            for (s, v) in row.iter().enumerate() {
+                if let Some(l) = model.limit(s) {
+                    let v = *v as f32;
+                    assert!(
+                        v >= l.lo - 1e-5 && v <= l.hi + 1e-5,
+                        "seed {seed}: q{s} = {v}"
+                    );
+                }
+            }
+        }
+        // Elevation and azimuth from the first camera's optical axis (the third row of R,
+        // pointing from the camera to the hand); distance to the palm at frame 0.
+        let cam = &a.file.cameras[0];
+        let view = cam.r[2];
+        let (dx, dy, dz) = (-view[0], -view[1], -view[2]);
+        elevations.push(dz.atan2((dx * dx + dy * dy).sqrt()).to_degrees());
+        let azimuth = dx.atan2(dy).to_degrees().rem_euclid(360.0);
+        quadrants[(azimuth / 90.0) as usize % 4] = true;
+        let e = eye(cam);
+        let palm = &a.truth[0][4..7];
+        distances.push(
+            ((e[0] - palm[0]).powi(2) + (e[1] - palm[1]).powi(2) + (e[2] - palm[2]).powi(2)).sqrt(),
+        );
+    }
+    let (lo, hi) = elevations
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(lo, hi), &e| (lo.min(e), hi.max(e)));
+    assert!(lo < 30.0 && hi > 80.0, "elevations {lo:.0}..{hi:.0}°");
+    assert!(lo > 10.0, "a camera below 10°: {lo:.0}°");
+    assert!(
+        quadrants.iter().all(|&q| q),
+        "azimuth quadrants {quadrants:?}"
+    );
+    let (dmin, dmax) = distances
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(lo, hi), &d| (lo.min(d), hi.max(d)));
+    assert!(
+        dmin < 600.0 && dmax > 1200.0,
+        "distances {dmin:.0}..{dmax:.0} mm"
+    );
+}
+
+#[test]
+fn the_benchmark_runs_a_tiny_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = RobustnessArgs {
+        seeds: 2,
+        first_seed: 7,
+        frames: 10,
+        size: (160, 120),
+        jobs: 2,
+        motion: Motion::Robust,
+        json: Some(dir.path().join("sweep.json")),
+        keep: None,
+    };
+    let sweep = run(&args).unwrap();
+    assert!(sweep.failed.is_empty(), "{:?}", sweep.failed);
+    assert_eq!(sweep.seeds.len(), 2);
+    for s in &sweep.seeds {
+        assert_eq!(s.stereo, s.seed % 2 == 0);
+        assert_eq!(s.frames, 10);
+        assert!((0.0..=1.0).contains(&s.track_life));
+        assert!(s.lost_flagged_and_true + s.lost_flagged_only + s.lost_true_only <= 10);
+        assert_eq!(s.nan_frames, 0);
+        assert!(s.iterations_per_frame >= 1.0, "{s:?}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("sweep.json")).unwrap())
+            .unwrap();
+    assert_eq!(json["seeds"].as_array().unwrap().len(), 2);
+    let text = sweep.to_string();
+    assert!(
+        text.contains("mono") && text.contains("stereo") && text.contains("lostP"),
+        "{text}"
+    );
+}
