@@ -27,7 +27,7 @@ fn random_rigs_are_seeded_in_view_within_limits_and_cover_the_hemisphere() {
     let model = Model::hand().unwrap();
     let (mut elevations, mut quadrants, mut distances) = (Vec::new(), [false; 4], Vec::new());
     for seed in 1..=40u64 {
-        let name = if seed % 2 == 0 {
+        let name = if seed.is_multiple_of(2) {
             "random-stereo"
         } else {
             "random-mono"
@@ -36,7 +36,7 @@ fn random_rigs_are_seeded_in_view_within_limits_and_cover_the_hemisphere() {
         let b = generate(name, &options(seed)).unwrap();
         assert_eq!(a.truth, b.truth, "seed {seed} not deterministic");
         assert_eq!(a.file.cameras, b.file.cameras);
-        assert_eq!(a.cameras.len(), if seed % 2 == 0 { 2 } else { 1 });
+        assert_eq!(a.cameras.len(), if seed.is_multiple_of(2) { 2 } else { 1 });
         assert_eq!(a.file.free.as_ref().unwrap().len(), 28);
         for row in &a.truth {
             for (s, v) in row.iter().enumerate() {
@@ -98,7 +98,7 @@ fn the_benchmark_runs_a_tiny_sweep() {
     assert!(sweep.failed.is_empty(), "{:?}", sweep.failed);
     assert_eq!(sweep.seeds.len(), 2);
     for s in &sweep.seeds {
-        assert_eq!(s.stereo, s.seed % 2 == 0);
+        assert_eq!(s.stereo, s.seed.is_multiple_of(2));
         assert_eq!(s.frames, 10);
         assert!((0.0..=1.0).contains(&s.track_life));
         assert!(s.lost_flagged_and_true + s.lost_flagged_only + s.lost_true_only <= 10);

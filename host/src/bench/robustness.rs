@@ -127,7 +127,7 @@ pub struct SeedResult {
 
 /// Renders, tracks and judges seed `seed` in `dir`.
 pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResult> {
-    let stereo = seed % 2 == 0;
+    let stereo = seed.is_multiple_of(2);
     let name = if stereo {
         "random-stereo"
     } else {
@@ -186,7 +186,8 @@ pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResu
             .get(k)
             .copied()
             .unwrap_or(f64::NAN);
-        let truly = !(tip <= tip_limit && palm_mm <= TRULY_LOST_PALM_MM);
+        let within = tip <= tip_limit && palm_mm <= TRULY_LOST_PALM_MM;
+        let truly = !within;
         let flagged = lost.get(k).is_some_and(|&v| v != 0.0);
         match (flagged, truly) {
             (true, true) => result.lost_flagged_and_true += 1,
@@ -197,7 +198,8 @@ pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResu
         if truly && result.first_truly_lost.is_none() {
             result.first_truly_lost = Some(k);
         }
-        if !flagged && !(palm_mm <= FAR_PALM_MM) {
+        let far = palm_mm.is_nan() || palm_mm > FAR_PALM_MM;
+        if !flagged && far {
             result.far_unflagged += 1;
         }
     }
