@@ -48,9 +48,9 @@ pub struct TrackerConfig {
     /// The frame is `lost` when the silhouette agreement falls this far below its reference
     /// (0..=1; the reference is the agreement of the first frame, then follows the frames
     /// not lost slowly, so a background's own level — plain or cluttered — sets the bar).
-    /// 0 turns the check off.
+    /// 0 turns the check off (default 0.04).
     pub lost_silhouette_drop: f32,
-    /// Samples along each side of the silhouette check's grid (0: no check).
+    /// Samples along each side of the silhouette check's grid (0: no check; default 24).
     pub silhouette_grid: u8,
     /// Slice search parameters.
     pub features: FeatureConfig,
@@ -69,8 +69,8 @@ impl Default for TrackerConfig {
             converged_mm: 5e-3,
             lost_min_found: 0.3,
             lost_rms_px: 6.0,
-            lost_silhouette_drop: 0.0,
-            silhouette_grid: 0,
+            lost_silhouette_drop: 0.04,
+            silhouette_grid: 24,
             features: FeatureConfig::default(),
             estimator: EstimatorConfig::default(),
             motion: MotionConfig::default(),

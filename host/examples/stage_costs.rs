@@ -56,6 +56,9 @@ struct Args {
     /// Residual form (default: the tracker's).
     #[arg(long, value_enum)]
     residual: Option<Residual>,
+    /// The thesis' plain loop: no motion model, no silhouette check (the cost before them).
+    #[arg(long)]
+    plain: bool,
 }
 
 /// The estimator's residual forms, as `--residual` spells them.
@@ -77,6 +80,11 @@ fn main() -> Result<()> {
 
     let mut config = TrackerConfig::default();
     config.iterations = args.iterations;
+    if args.plain {
+        config.motion = digiteyes_core::motion::MotionConfig::PLAIN;
+        config.silhouette_grid = 0;
+        config.lost_silhouette_drop = 0.0;
+    }
     if !args.converge {
         config.converged_rad = 0.0;
         config.converged_mm = 0.0;

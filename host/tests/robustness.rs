@@ -90,7 +90,7 @@ fn the_benchmark_runs_a_tiny_sweep() {
         frames: 10,
         size: (160, 120),
         jobs: 2,
-        motion: Motion::Robust,
+        motion: Motion::Plain,
         json: Some(dir.path().join("sweep.json")),
         keep: None,
     };

@@ -8,33 +8,25 @@ use digiteyes_core::camera::Camera;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::{Model, Shape};
-use digiteyes_core::motion::{MotionConfig, PriorWeights};
+use digiteyes_core::motion::MotionConfig;
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
 use digiteyes_host::render::{RenderSettings, Renderer};
 use digiteyes_host::scenarios::{render_scenario, RenderOptions};
 use digiteyes_host::sequence::Sequence;
 use image::GrayImage;
 
-/// The motion model this test judges (the tracker's default once tuned on the sweep).
+/// The tracker as it ships: the motion model on (`MotionConfig::DEFAULT`, the silhouette
+/// check).
 fn robust_config() -> TrackerConfig {
-    let mut config = TrackerConfig::default();
-    let mut motion = MotionConfig::PLAIN;
-    motion.hold_when_lost = true;
-    motion.full_velocity_found = 0.7;
-    motion.prior = PriorWeights {
-        quaternion: 0.0,
-        translation: 5.0,
-        joint: 2000.0,
-    };
-    config.motion = motion;
-    config.silhouette_grid = 24;
-    config.lost_silhouette_drop = 0.04;
-    config
+    TrackerConfig::default()
 }
 
+/// The loop as the thesis ran it, for contrast.
 fn plain_config() -> TrackerConfig {
     let mut config = TrackerConfig::default();
     config.motion = MotionConfig::PLAIN;
+    config.silhouette_grid = 0;
+    config.lost_silhouette_drop = 0.0;
     config
 }
 

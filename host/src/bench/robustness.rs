@@ -9,7 +9,7 @@ use std::sync::Mutex;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use digiteyes_core::motion::{MotionConfig, PriorWeights};
+use digiteyes_core::motion::MotionConfig;
 use serde::Serialize;
 
 use crate::eval::{evaluate, stats};
@@ -31,28 +31,21 @@ pub const FAR_PALM_MM: f64 = 100.0;
 /// The tracker configurations the benchmark compares.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize)]
 pub enum Motion {
-    /// The tracker's defaults.
+    /// The tracker's defaults (the motion model on).
     Default,
-    /// The motion model switched on: priors, observed velocity, hold when lost, silhouette.
-    Robust,
+    /// The loop as the thesis ran it: no prior, the full velocity, a lost frame's estimate
+    /// kept, no silhouette check.
+    Plain,
 }
 
 impl Motion {
     /// The tracker configuration.
     pub fn config(self) -> TrackerConfig {
         let mut config = TrackerConfig::default();
-        if self == Motion::Robust {
-            let mut motion = MotionConfig::PLAIN;
-            motion.prior = PriorWeights {
-                quaternion: 0.0,
-                translation: 1.0,
-                joint: 2000.0,
-            };
-            motion.full_velocity_found = 0.7;
-            motion.hold_when_lost = true;
-            config.motion = motion;
-            config.silhouette_grid = 24;
-            config.lost_silhouette_drop = 0.04;
+        if self == Motion::Plain {
+            config.motion = MotionConfig::PLAIN;
+            config.silhouette_grid = 0;
+            config.lost_silhouette_drop = 0.0;
         }
         config
     }
