@@ -435,6 +435,7 @@ struct PortArgs {
 }
 
 fn main() -> ExitCode {
+    quiet_on_closed_pipe();
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
@@ -724,6 +725,25 @@ fn run(cli: Cli) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `digiteyes eval ... | head` closes the pipe early; Rust ignores SIGPIPE, so the next
+/// `println!` panics. Like any Unix tool, end quietly instead (exit status 141, as a process
+/// killed by SIGPIPE reports in a shell); every other panic is reported as before.
+fn quiet_on_closed_pipe() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let message = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if message.starts_with("failed printing to stdout") && message.contains("Broken pipe") {
+            std::process::exit(141);
+        }
+        default(info);
+    }));
 }
 
 fn tracker_config(iterations: Option<u8>, no_predict: bool) -> TrackerConfig {

@@ -296,3 +296,22 @@ fn a_camera_that_cannot_see_the_hand_is_refused_by_name() {
         );
     }
 }
+
+/// `digiteyes ... | head`: a reader that goes away ends the command quietly, not in a panic.
+#[test]
+fn a_closed_stdout_pipe_is_not_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
+        .args(["render", "mouse", "out", "--frames", "1", "--size", "32x24"])
+        .args(["--supersample", "1"])
+        .current_dir(dir.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take()); // the reader is gone before the first line
+    let out = child.wait_with_output().unwrap();
+    let err = stderr(&out);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_ne!(out.status.code(), Some(101), "{err}");
+}
