@@ -21,6 +21,19 @@ use crate::model::Model;
 use crate::motion::{velocity_trust, MotionConfig};
 use crate::projection::ProjectedModel;
 
+/// The cameras, if there are 1 to [`MAX_CAMERAS`] and each is usable.
+fn checked_cameras(cameras: &[Camera]) -> Result<Vec<Camera, MAX_CAMERAS>, TrackerError> {
+    if cameras.is_empty() {
+        return Err(TrackerError::CameraCount);
+    }
+    let cameras: Vec<Camera, MAX_CAMERAS> =
+        Vec::from_slice(cameras).map_err(|_| TrackerError::CameraCount)?;
+    for c in &cameras {
+        c.validate().map_err(TrackerError::Camera)?;
+    }
+    Ok(cameras)
+}
+
 /// How far beyond a frame's edges (share of its width and height) the palm's origin may
 /// project before a frame is `lost` for having left every camera's view.
 pub const VIEW_SLACK: f32 = 0.25;
@@ -177,14 +190,7 @@ impl Tracker {
         free: Option<&[u8]>,
         config: TrackerConfig,
     ) -> Result<Self, TrackerError> {
-        if cameras.is_empty() {
-            return Err(TrackerError::CameraCount);
-        }
-        let cameras: Vec<Camera, MAX_CAMERAS> =
-            Vec::from_slice(cameras).map_err(|_| TrackerError::CameraCount)?;
-        for c in &cameras {
-            c.validate().map_err(TrackerError::Camera)?;
-        }
+        let cameras = checked_cameras(cameras)?;
         let n = model.n_states();
         let mask = match free {
             None => FreeMask::all(n),
@@ -232,14 +238,7 @@ impl Tracker {
         cameras: &[Camera],
         config: TrackerConfig,
     ) -> Result<(), TrackerError> {
-        if cameras.is_empty() {
-            return Err(TrackerError::CameraCount);
-        }
-        let cameras: Vec<Camera, MAX_CAMERAS> =
-            Vec::from_slice(cameras).map_err(|_| TrackerError::CameraCount)?;
-        for c in &cameras {
-            c.validate().map_err(TrackerError::Camera)?;
-        }
+        let cameras = checked_cameras(cameras)?;
         self.cameras = cameras;
         self.config = config;
         self.work.reach = [[f32::INFINITY; MAX_FRAMES]; MAX_CAMERAS];

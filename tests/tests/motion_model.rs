@@ -2,6 +2,8 @@
 //! state instead of extrapolating; a visibly wrong track is flagged `lost` from the silhouette
 //! within a few frames while a right one is not; a finger seen end-on keeps its joints.
 
+mod common;
+
 use std::path::Path;
 
 use digiteyes_core::camera::Camera;
@@ -11,7 +13,6 @@ use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::motion::MotionConfig;
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
 use digiteyes_host::render::{RenderSettings, Renderer};
-use digiteyes_host::scenarios::{render_scenario, RenderOptions};
 use digiteyes_host::sequence::Sequence;
 use image::GrayImage;
 
@@ -30,17 +31,9 @@ fn plain_config() -> TrackerConfig {
     config
 }
 
-/// A rendered mouse sequence at 320×240.
+/// A rendered mouse sequence at 320×240 (`common::mouse`), opened.
 fn mouse(dir: &Path, frames: usize) -> Sequence {
-    let seq = dir.join("mouse");
-    let options = RenderOptions {
-        frames: Some(frames),
-        size: Some((320, 240)),
-        supersample: 2,
-        ..RenderOptions::default()
-    };
-    render_scenario("mouse", &seq, &options).unwrap();
-    Sequence::open(&seq).unwrap()
+    Sequence::open(&common::mouse(dir, frames)).unwrap()
 }
 
 fn tracker(seq: &Sequence, config: TrackerConfig) -> Tracker {
