@@ -15,6 +15,8 @@
 //!   initial state) and released again only once back within [`MouseConfig::release_rad`] —
 //!   hysteresis, so a noisy angle near the threshold does not chatter.
 
+pub mod accuracy;
+
 use anyhow::{anyhow, bail, Context, Result};
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::{Model, Shape};

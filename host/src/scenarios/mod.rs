@@ -10,6 +10,7 @@
 pub mod cameras;
 pub mod catalogue;
 pub mod measure;
+pub mod mouse_thesis;
 pub mod trajectory;
 
 use std::path::Path;
@@ -115,6 +116,10 @@ pub fn generate(name: &str, opts: &RenderOptions) -> Result<Generated> {
     let horizon = frames.max(DEFAULT_FRAMES);
     let mut shrink = 1.0;
     let (truth, time_scale, amplitude_factor) = loop {
+        if name == mouse_thesis::NAME {
+            let truth = mouse_thesis::sample(&model, &full_size, &scenario.base, frames)?;
+            break (truth, mouse_thesis::thesis_time(1, frames), 1.0);
+        }
         let motion = Motion::random(
             scenario.base.clone(),
             &amplitudes,
