@@ -1,0 +1,298 @@
+//! The UI's 3D mouse in a real browser: `digiteyes ui` fed over UDP (as `listen --forward
+//! udp://` sends) with states of the thesis' mouse trial, loaded in headless Chromium. A thumb
+//! click with the cursor (the pole's top) inside a sphere selects it; a thumb click with the
+//! cursor elsewhere, or a finger-4 click, drops the selection; resting inside a sphere selects
+//! nothing.
+//!
+//! Needs Debian's `chromium` (scripts/test installs it; `DIGITEYES_CHROMIUM` names another
+//! binary). Without it the test prints `SKIPPED: ...` to stderr and passes (under `CI=true` it
+//! fails).
+
+mod common;
+
+use std::net::{SocketAddr, UdpSocket};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use digiteyes_core::protocol::{BoardMessage, State};
+use digiteyes_host::scenarios::{mouse_thesis, scenario};
+use digiteyes_host::ui::{RunningUi, UiOptions, UiSource};
+
+/// Sphere A of app.js: where the trial's raised finger holds the cursor, (0, 0, 48) mm.
+const SPHERE_A: &str = "A";
+/// A state is sent this often (the board's frame period).
+const SEND_PERIOD: Duration = Duration::from_millis(40);
+/// Each step of the script is sent this many times in a row, so a page polling every 50 ms
+/// sees it.
+const REPEATS: usize = 5;
+/// How long the page runs (ms of its time; about as many of the wall clock's, as it waits on
+/// the server): three rounds of the script (11 steps × 5 × 40 ms each).
+const PAGE_BUDGET_MS: u32 = 7_000;
+
+/// The browser, or why the test is skipped.
+fn chromium() -> Result<PathBuf, String> {
+    let candidates: Vec<PathBuf> = match std::env::var_os("DIGITEYES_CHROMIUM") {
+        Some(path) => vec![PathBuf::from(path)],
+        None => ["chromium", "chromium-browser", "google-chrome"]
+            .iter()
+            .map(PathBuf::from)
+            .collect(),
+    };
+    for exe in candidates {
+        let works = Command::new(&exe)
+            .arg("--version")
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success());
+        if works {
+            return Ok(exe);
+        }
+    }
+    Err("no chromium found (apt-get install -y chromium, or set DIGITEYES_CHROMIUM)".into())
+}
+
+/// Loads `url` in headless Chromium with a fresh profile, lets the page run for
+/// `budget_ms` of its (virtual) time, and returns the DOM it ends with.
+fn dump_dom(exe: &Path, url: &str, budget_ms: u32) -> String {
+    let profile = tempfile::tempdir().unwrap();
+    let output = Command::new(exe)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--hide-scrollbars",
+            "--window-size=1340,1100",
+            "--dump-dom",
+        ])
+        .arg(format!("--virtual-time-budget={budget_ms}"))
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .arg(url)
+        .stdin(Stdio::null())
+        .output()
+        .expect("chromium runs");
+    assert!(
+        output.status.success(),
+        "chromium failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+/// The value of `data-NAME` on the page's `<body>`.
+fn body_data<'a>(dom: &'a str, name: &str) -> &'a str {
+    let body = &dom[dom.find("<body").expect("a <body>")..];
+    let tag = &body[..body.find('>').unwrap()];
+    let key = format!(r#"data-{name}=""#);
+    let start = tag
+        .find(&key)
+        .unwrap_or_else(|| panic!("no data-{name} on <body>: {tag}"))
+        + key.len();
+    &tag[start..start + tag[start..].find('"').unwrap()]
+}
+
+fn state_message(frame: u32, q: &[f32]) -> String {
+    let message = BoardMessage::State(State {
+        frame,
+        timestamp: u64::from(frame) * 1000,
+        q: heapless::Vec::from_slice(q).unwrap(),
+        rms_px: 0.75,
+        lost: false,
+        features_found: 40,
+        features_expected: 42,
+        iterations: 3,
+        track_ticks: 5000,
+    });
+    format!("{}\n", serde_json::to_string(&message).unwrap())
+}
+
+/// Sends `first` once, then the states of `script` in a loop (each [`REPEATS`] times, one
+/// every [`SEND_PERIOD`]) until dropped, as `listen --forward udp://` would.
+struct Streamer {
+    stop: Arc<AtomicBool>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Streamer {
+    fn start(to: SocketAddr, first: Vec<f32>, script: Vec<Vec<f32>>) -> Streamer {
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&stop);
+        let thread = std::thread::spawn(move || {
+            let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
+            let mut frame = 0;
+            let mut send = |q: &[f32]| {
+                socket
+                    .send_to(state_message(frame, q).as_bytes(), to)
+                    .unwrap();
+                frame += 1;
+                // The board's frame period: pacing the stream, not waiting for anything.
+                std::thread::sleep(SEND_PERIOD);
+            };
+            send(&first);
+            while !flag.load(Ordering::Relaxed) {
+                for q in &script {
+                    for _ in 0..REPEATS {
+                        send(q);
+                    }
+                }
+            }
+        });
+        Streamer {
+            stop,
+            thread: Some(thread),
+        }
+    }
+}
+
+impl Drop for Streamer {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// The trial's state with the finger held up over the palm's rest position (the cursor at
+/// about (0, 0, 48) mm, inside sphere A), both buttons at rest.
+fn finger_up() -> Vec<f32> {
+    let base = scenario(mouse_thesis::NAME).unwrap().base;
+    let q = mouse_thesis::state_at(&base, 170.0);
+    q.iter().map(|&v| v as f32).collect()
+}
+
+/// Serves the UI from UDP, streams `first` and then `script` in a loop to it, loads the page in
+/// Chromium for [`PAGE_BUDGET_MS`] and returns the DOM it ends with.
+fn run_page(exe: &Path, first: &[f32], script: Vec<Vec<f32>>) -> String {
+    let options = UiOptions {
+        bind: "127.0.0.1:0".parse().unwrap(),
+        source: UiSource::Udp("127.0.0.1:0".parse().unwrap()),
+        duration: None,
+    };
+    let ui = RunningUi::start(&options, &mut std::io::sink()).expect("the UI starts");
+    let streamer = Streamer::start(ui.udp_addr().unwrap(), first.to_vec(), script);
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while ui.hub().snapshot().link.states < 2 {
+        assert!(
+            Instant::now() < deadline,
+            "no state reached the UI over UDP"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let started = Instant::now();
+    let dom = dump_dom(exe, &ui.url(), PAGE_BUDGET_MS);
+    println!("the page ran {:.1} s", started.elapsed().as_secs_f64());
+    drop(streamer);
+    ui.stop().unwrap();
+    dom
+}
+
+/// `q` with state `s` moved by `d`.
+fn with(q: &[f32], s: usize, d: f32) -> Vec<f32> {
+    let mut q = q.to_vec();
+    q[s] += d;
+    q
+}
+
+/// The thumb's abduction (a button).
+const THUMB: usize = 24;
+/// Finger 4's abduction (a button).
+const FINGER4: usize = 19;
+/// The palm's x on the table.
+const PALM_X: usize = 4;
+
+fn chromium_or_skip(test: &str) -> Option<PathBuf> {
+    match chromium() {
+        Ok(exe) => Some(exe),
+        Err(reason) => {
+            common::skip(
+                &format!("UI mouse test `{test}` (tests/tests/ui_mouse.rs)"),
+                &reason,
+            );
+            None
+        }
+    }
+}
+
+#[test]
+fn a_thumb_click_inside_a_sphere_selects_it_and_nothing_else_does() {
+    let Some(exe) = chromium_or_skip("select") else {
+        return;
+    };
+    let on_a = finger_up();
+    let click = mouse_thesis::CLICK_RAD as f32;
+    let thumb = |q: &[f32]| with(q, THUMB, click);
+    let finger4 = |q: &[f32]| with(q, FINGER4, click);
+    // 40 mm along x: inside no sphere.
+    let away = with(&on_a, PALM_X, 40.0);
+    let script = vec![
+        on_a.clone(),
+        thumb(&on_a), // select A
+        on_a.clone(),
+        away.clone(),
+        thumb(&away), // a click off every sphere drops it
+        away.clone(),
+        on_a.clone(), // resting inside A selects nothing
+        thumb(&on_a), // select A again
+        on_a.clone(),
+        finger4(&on_a), // finger 4 drops it
+        on_a.clone(),
+    ];
+    let dom = run_page(&exe, &on_a, script);
+    let events = body_data(&dom, "mouse-events");
+    println!("selection events: {events}");
+    let thumb_presses: usize = body_data(&dom, "thumb-presses").parse().unwrap();
+    let finger4_presses: usize = body_data(&dom, "finger4-presses").parse().unwrap();
+    assert!(
+        thumb_presses >= 2 && finger4_presses >= 1,
+        "the page did not see the script's clicks: {thumb_presses} thumb, {finger4_presses} finger 4"
+    );
+    let events: Vec<&str> = events.split_whitespace().collect();
+    // Only A is ever selected; each kind of drop happened.
+    for kind in [
+        format!("select:{SPHERE_A}"),
+        "drop:thumb".to_string(),
+        "drop:finger4".to_string(),
+    ] {
+        assert!(events.contains(&kind.as_str()), "no {kind} in {events:?}");
+    }
+    assert!(
+        events
+            .iter()
+            .all(|e| e.starts_with("drop:") || *e == format!("select:{SPHERE_A}")),
+        "{events:?}"
+    );
+}
+
+#[test]
+fn resting_inside_a_sphere_or_clicking_outside_selects_nothing() {
+    let Some(exe) = chromium_or_skip("no selection") else {
+        return;
+    };
+    let on_a = finger_up();
+    let away = with(&on_a, PALM_X, 40.0);
+    let thumb_away = with(&away, THUMB, mouse_thesis::CLICK_RAD as f32);
+    let dom = run_page(
+        &exe,
+        &on_a,
+        vec![on_a.clone(), away.clone(), thumb_away, away],
+    );
+    let hovered: usize = body_data(&dom, "mouse-hovered").parse().unwrap();
+    let thumb_presses: usize = body_data(&dom, "thumb-presses").parse().unwrap();
+    // The page saw the cursor inside A and saw the thumb click, never together.
+    assert!(
+        hovered >= 1 && thumb_presses >= 1,
+        "hovered {hovered}, thumb presses {thumb_presses}"
+    );
+    assert_eq!(body_data(&dom, "mouse-events"), "");
+    assert_eq!(body_data(&dom, "mouse-selected"), "");
+    assert!(dom.contains("nothing selected") || dom.contains("cursor inside sphere A"));
+}
