@@ -191,7 +191,11 @@ pub fn sample(
         for (s, &v) in q.iter().enumerate() {
             if let Some(l) = model.limit(s) {
                 if !(f64::from(l.lo)..=f64::from(l.hi)).contains(&v) {
-                    bail!("{NAME}: frame {k}: q{s} = {v} leaves its range {l:?}");
+                    bail!(
+                        "{NAME}: frame {k}: q{s} = {v} rad leaves its range {} .. {} rad",
+                        l.lo,
+                        l.hi
+                    );
                 }
             }
         }
