@@ -1,11 +1,12 @@
-//! The demo: render the `mouse` scenario, stream it to a simulated Linux board over a real
-//! pseudo-terminal serial link, evaluate the states the board sent back, write the HTML
-//! report, and show the run in the UI.
+//! The demo: render the thesis' four-phase 3D-mouse trial (`mouse-thesis`), stream it to a
+//! simulated Linux board over a real pseudo-terminal serial link, evaluate the states the board
+//! sent back (as a tracker and as a 3D mouse), write the HTML report, and show the run in the
+//! UI, whose mouse pole rises twice, holds while the thumb clicks, and slides.
 //!
 //! ```text
 //! renderer ─▶ camN/*.pgm ─▶ host (stream) ═══ PTY ═══ board (firmware loop, tracker)
 //!                               ▲                          │
-//!                               └──── State per frame ◀────┘ ─▶ states.csv ─▶ eval
+//!                               └──── State per frame ◀────┘ ─▶ states.csv ─▶ eval (+ mouse)
 //!                                                                     ├─▶ report.html
 //!                                                                     └─▶ ui (replay)
 //! ```
@@ -20,17 +21,27 @@ use digiteyes_board_linux::{SimOptions, SimReport};
 use digiteyes_core::protocol::TrackerParams;
 
 use crate::eval::{evaluate, EvalReport};
+use crate::mouse_pole::accuracy::{compare, MouseAccuracy};
+use crate::mouse_pole::MouseConfig;
 use crate::report::{write_report, ReportOptions, ReportSummary};
 use crate::scenarios::{render_scenario, RenderOptions};
+use crate::sequence::{read_states, Sequence};
 use crate::stream::{stream_sequence, StreamOptions, StreamSummary};
 use crate::ui::{run_ui, UiOptions, UiSource, DEFAULT_BIND};
 use crate::TrackerConfig;
 
-/// The scenario the demo runs.
-pub const DEMO_SCENARIO: &str = "mouse";
+/// The scenario the demo runs: the thesis' 3D-mouse trial.
+pub const DEMO_SCENARIO: &str = crate::scenarios::mouse_thesis::NAME;
+
+/// Frames the demo renders unless told otherwise: the thesis' 500, its pace (about 25 s of
+/// render, upload and tracking on a 2-core machine at 640×480; `docs/ui.md`).
+pub const DEMO_FRAMES: usize = crate::scenarios::mouse_thesis::THESIS_FRAMES;
 
 /// Where the demo writes its run unless told otherwise (relative to the current folder).
 pub const DEFAULT_DEMO_DIR: &str = "digiteyes-demo";
+
+/// About this many overlay thumbnails in the demo's report, whatever its length.
+pub const DEMO_THUMBNAILS: usize = 20;
 
 /// The report's file name in the demo's folder.
 pub const REPORT_HTML: &str = "report.html";
@@ -46,13 +57,16 @@ pub struct DemoResult {
     pub board: SimReport,
     /// The evaluation of the board's states.
     pub eval: EvalReport,
+    /// The board's states as a 3D mouse, against the truth's.
+    pub mouse: MouseAccuracy,
     /// The HTML report of the run.
     pub report: ReportSummary,
 }
 
-/// Renders `frames` frames of the `mouse` scenario into `dir`, streams them to a simulated
-/// board running `config`, evaluates the states it sent back (written to `dir/states.csv`)
-/// and writes the HTML report `dir/report.html`.
+/// Renders the [`DEMO_SCENARIO`] into `dir` in `frames` frames (its four phases shrink in
+/// proportion below [`DEMO_FRAMES`]), streams them to a simulated board running `config`,
+/// evaluates the states it sent back (written to `dir/states.csv`), as a tracker and as a 3D
+/// mouse, and writes the HTML report `dir/report.html`.
 pub fn run_demo(
     frames: usize,
     dir: &Path,
@@ -73,19 +87,36 @@ pub fn run_demo(
     let stream = stream_sequence(dir, &states, &options)?;
     let board = board.stop().context("the simulated board failed")?;
     let eval = evaluate(dir, &states)?;
-    let report = write_report(
-        dir,
-        &states,
-        &dir.join(REPORT_HTML),
-        &ReportOptions::default(),
-    )?;
+    let mouse = mouse_accuracy(dir, &states)?;
+    let report_options = ReportOptions {
+        thumb_every: frames.div_ceil(DEMO_THUMBNAILS).max(1),
+        ..ReportOptions::default()
+    };
+    let report = write_report(dir, &states, &dir.join(REPORT_HTML), &report_options)?;
     Ok(DemoResult {
         sequence: dir.to_path_buf(),
         stream,
         board,
         eval,
+        mouse,
         report,
     })
+}
+
+/// The states in `states_csv` as a 3D mouse against the truth of the sequence in `dir`.
+fn mouse_accuracy(dir: &Path, states_csv: &Path) -> Result<MouseAccuracy> {
+    let sequence = Sequence::open(dir)?;
+    let truth = sequence.read_truth()?;
+    let estimate = read_states(states_csv, sequence.n_states())?;
+    let rest: Vec<f32> = sequence.initial_state.iter().map(|&v| v as f32).collect();
+    compare(
+        &sequence.model,
+        &rest,
+        MouseConfig::default(),
+        &truth.rows,
+        &estimate.rows,
+    )
+    .with_context(|| format!("{}", states_csv.display()))
 }
 
 /// Shows the demo's run in the UI: replays `dir`'s frames and states, served on

@@ -11,7 +11,7 @@ use anyhow::{bail, Result};
 use clap::{Args, Parser, Subcommand};
 use digiteyes_board_linux::SimOptions;
 use digiteyes_host::cli_values;
-use digiteyes_host::demo::{run_demo, serve_demo_ui, DEFAULT_DEMO_DIR, REPORT_HTML};
+use digiteyes_host::demo::{run_demo, serve_demo_ui, DEFAULT_DEMO_DIR, DEMO_FRAMES, REPORT_HTML};
 use digiteyes_host::forward::one_euro::{self, Smoothing};
 use digiteyes_host::forward::parse_forward;
 use digiteyes_host::link::Link;
@@ -49,6 +49,10 @@ enum Command {
     ///   mouse            3D-mouse sub-model (free q4 q5 q8 q9 q10 q19 q24): palm slides on the
     ///                    table, finger 1 flexes, finger 4 and thumb abduct; one camera at 45°;
     ///                    fingertips <= 4 px/frame
+    ///   mouse-thesis     the thesis' 3D-mouse trial (free q0..q5 q8 q9 q10 q19 q24), scripted in
+    ///                    four phases: finger 1 raised and lowered twice; held up while the thumb
+    ///                    clicks; palm slides and yaws; all at once. --frames 500 is the thesis'
+    ///                    pace (fewer frames: the same trial, faster)
     ///   rigid            palm pose only (q0..q6): ±20° rotation, ±30 mm translation
     ///   twofinger        fingers 1 and 2 (3 joints each) + palm translation (q4 q5 q6)
     ///   fullhand-stereo  all 28 states, two cameras 35° apart facing the palm
@@ -379,7 +383,9 @@ enum Command {
     /// Measure the tracker beyond what a test should: `bench robustness`.
     #[command(subcommand)]
     Bench(BenchCommand),
-    /// Render the `mouse` scenario, stream it to a simulated board, evaluate, report, show.
+    /// Render the thesis' 3D-mouse trial, stream it to a board, evaluate, report, show.
+    ///
+    /// The trial is the `mouse-thesis` scenario (see `render --help`).
     ///
     /// The rendered camera's frames go to a simulated Linux board (the firmware loop on a
     /// pseudo-terminal, as `digiteyes sim` runs it) over a real serial link; the states it
@@ -389,8 +395,8 @@ enum Command {
     /// overlay, 3D mouse, link figures) until Ctrl-C; otherwise it prints the
     /// `digiteyes ui --replay` command that shows it.
     Demo {
-        /// Number of frames (1 to 100000).
-        #[arg(long, default_value_t = DEFAULT_FRAMES, value_parser = cli_values::frame_count)]
+        /// Number of frames (500: the thesis' pace; fewer play the same trial faster).
+        #[arg(long, default_value_t = DEMO_FRAMES, value_parser = cli_values::frame_count)]
         frames: usize,
         /// Folder for the run: the sequence, states.csv and report.html (created if
         /// missing; its files are overwritten).
@@ -694,6 +700,7 @@ fn run(cli: Cli) -> Result<()> {
             println!("{}", result.stream);
             println!("{}", result.board);
             print!("{}", result.eval);
+            println!("{}", result.mouse);
             let dir = std::path::absolute(&result.sequence).unwrap_or(result.sequence);
             println!("run kept in {}", dir.display());
             println!();

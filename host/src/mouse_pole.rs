@@ -1,19 +1,25 @@
 //! The 3D mouse of the thesis (Rehg 1995, Sec. 4.3.4): the mouse sub-model's states read as a
 //! pole standing on the table, with two buttons.
 //!
-//! The mouse sub-model (scenario `mouse`) frees the palm's translation on the table (q4, q5),
-//! finger 1's three flexions (q8, q9, q10), finger 4's abduction (q19) and the thumb's
-//! (q24). In the table set-up (world z up, the table is z = 0, the hand palm-down above it):
+//! The thesis' mouse sub-model (scenario `mouse-thesis`) frees the palm's 3 DOF in the table
+//! plane — its translation (q4, q5) and its rotation about the table's normal, through the
+//! quaternion (q0..q3, free together) — finger 1's three flexions (q8, q9, q10), finger 4's
+//! abduction (q19) and the thumb's (q24); the `mouse` scenario (the `sample-mouse` fixture's
+//! sub-model) keeps the palm's rotation fixed. In the table set-up (world z up, the table is
+//! z = 0, the hand palm-down above it):
 //!
-//! - the pole's **base** follows the palm across the table: `(x, y) = (q4, q5)` mm, world;
+//! - the pole's **base** follows the palm across the table: `(x, y) = (q4, q5)` mm, world
+//!   (the palm's yaw moves the hand, not the base);
 //! - its **height** follows finger 1's fingertip: the world z of the `finger1.tip` frame's
 //!   origin minus the fingertip radius, i.e. the gap between the fingertip's surface and the
-//!   table (mm, clamped at 0). Flexing finger 1 curls it towards the palm side — down, for a
-//!   palm-down hand — and lowers the pole;
+//!   table (mm, clamped at 0). Raising finger 1 (its MCP extended, q8 < 0) lifts the pole;
+//!   flexing it curls it towards the palm side — down, for a palm-down hand — and lowers it;
 //! - its two **buttons** are finger 4's and the thumb's abduction: a button is pressed when
 //!   its angle is more than [`MouseConfig::press_rad`] from its rest value (the sequence's
 //!   initial state) and released again only once back within [`MouseConfig::release_rad`] —
 //!   hysteresis, so a noisy angle near the threshold does not chatter.
+
+pub mod accuracy;
 
 use anyhow::{anyhow, bail, Context, Result};
 use digiteyes_core::kinematics::Poses;

@@ -14,6 +14,7 @@
 pub mod accuracy;
 pub mod html;
 pub mod input;
+pub mod mouse;
 pub mod plots;
 pub mod svg;
 pub mod thumbnails;
@@ -26,6 +27,7 @@ use anyhow::Result;
 use digiteyes_core::features::FeatureConfig;
 
 use crate::eval::EvalReport;
+use crate::mouse_pole::accuracy::MouseAccuracy;
 use crate::state_names::state_label;
 use accuracy::{accuracy, Accuracy};
 use html::Page;
@@ -75,6 +77,11 @@ pub struct ReportSummary {
     pub state_plots: usize,
     /// Error-over-time plots.
     pub error_plots: usize,
+    /// 3D-mouse plots (the thesis' Fig. 4.12), for a 3D-mouse sub-model.
+    pub mouse_plots: usize,
+    /// The 3D mouse read off the estimate against the truth's, for a 3D-mouse sub-model with a
+    /// truth.
+    pub mouse: Option<MouseAccuracy>,
     /// Overlay thumbnails.
     pub thumbnails: usize,
     /// Size of the page (bytes).
@@ -116,6 +123,13 @@ impl fmt::Display for ReportSummary {
                 )?;
             }
             None => write!(f, "; no truth.csv")?,
+        }
+        if let Some(m) = &self.mouse {
+            write!(
+                f,
+                "; 3D mouse: pole height {:.2} mm RMS, base {:.2} mm RMS",
+                m.height_rms_mm, m.base_rms_mm
+            )?;
         }
         write!(
             f,
@@ -179,6 +193,20 @@ pub fn build_report(
     page.heading("Error over time");
     let error_plots = plots::error_plots(&inputs, accuracy.as_ref());
     page.raw(&grid(&error_plots));
+    let mouse = mouse::mouse_section(&inputs)?;
+    if let Some(section) = &mouse {
+        page.heading("3D mouse (the thesis' Fig. 4.12)");
+        page.paragraph(
+            "The 3D mouse's pole read off the states (thesis Sec. 4.3.4): its base is the \
+             palm's position on the table, its height finger 1's fingertip above the table; \
+             finger 4's and the thumb's abduction are its buttons, pressed beyond 0.15 rad \
+             from their rest at the first frame.",
+        );
+        if let Some(acc) = &section.accuracy {
+            page.pre(&acc.to_string());
+        }
+        page.raw(&grid(&section.plots));
+    }
     page.heading(&format!("Free states ({})", free.len()));
     page.paragraph(legend_note(&inputs));
     let state_plots: Vec<String> = free
@@ -204,6 +232,8 @@ pub fn build_report(
         cameras: inputs.sequence.cameras.len(),
         state_plots: state_plots.len(),
         error_plots: error_plots.len(),
+        mouse_plots: mouse.as_ref().map_or(0, |m| m.plots.len()),
+        mouse: mouse.and_then(|m| m.accuracy),
         thumbnails: thumbs.len(),
         bytes: html.len(),
         lost_frames: inputs.lost.iter().filter(|&&l| l).count(),

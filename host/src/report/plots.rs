@@ -23,22 +23,38 @@ pub fn state_plot(inputs: &Inputs, state: usize) -> String {
         .truth
         .as_ref()
         .map(|t| t.rows.iter().map(|r| r[state]).collect());
-    let range = finite_range(estimate.iter().chain(truth.iter().flatten())).unwrap_or((0.0, 1.0));
+    estimate_plot(
+        inputs,
+        &estimate,
+        truth.as_deref(),
+        &format!(r#" class="state-plot" data-state="{state}""#),
+        &state_label(state),
+        state_unit(state),
+    )
+}
+
+/// A series derived from the states against time, one value per frame (NaN: a gap): the
+/// estimate as `polyline.estimate`, the truth (when given) as `polyline.truth`, lost frames,
+/// dropped frames and gaps marked as on the state plots; `attributes` go on the `<svg>`.
+pub fn estimate_plot(
+    inputs: &Inputs,
+    estimate: &[f64],
+    truth: Option<&[f64]>,
+    attributes: &str,
+    title: &str,
+    unit: &str,
+) -> String {
+    let range =
+        finite_range(estimate.iter().chain(truth.iter().copied().flatten())).unwrap_or((0.0, 1.0));
     let mut chart = new_chart(inputs, range);
     let mut legend = decorate(&mut chart, inputs);
-    if let Some(truth) = &truth {
+    if let Some(truth) = truth {
         chart.line(&inputs.times, truth, "truth");
         legend.insert(0, entry("truth", "truth"));
     }
-    chart.line(&inputs.times, &estimate, "estimate");
+    chart.line(&inputs.times, estimate, "estimate");
     legend.insert(0, entry("estimate", "estimate"));
-    chart.finish(
-        &format!(r#" class="state-plot" data-state="{state}""#),
-        &state_label(state),
-        inputs.time_label(),
-        state_unit(state),
-        &legend,
-    )
+    chart.finish(attributes, title, inputs.time_label(), unit, &legend)
 }
 
 /// The error-over-time plots: with an accuracy, the mean fingertip reprojection error (px,
@@ -110,7 +126,7 @@ fn series_plot(
     )
 }
 
-fn new_chart(inputs: &Inputs, y_range: (f64, f64)) -> Chart {
+pub(super) fn new_chart(inputs: &Inputs, y_range: (f64, f64)) -> Chart {
     let first = inputs.times.first().copied().unwrap_or(0.0);
     let last = inputs.times.last().copied().unwrap_or(1.0);
     Chart::new((first, last), y_range)
@@ -118,7 +134,7 @@ fn new_chart(inputs: &Inputs, y_range: (f64, f64)) -> Chart {
 
 /// Shades the lost frames and marks the dropped frames and NaN gaps; returns the legend
 /// entries of what was drawn.
-fn decorate(chart: &mut Chart, inputs: &Inputs) -> Vec<LegendEntry> {
+pub(super) fn decorate(chart: &mut Chart, inputs: &Inputs) -> Vec<LegendEntry> {
     let mut legend = Vec::new();
     let half = inputs.half_frame();
     let runs = Inputs::runs(&inputs.lost);
@@ -161,7 +177,7 @@ fn decorate(chart: &mut Chart, inputs: &Inputs) -> Vec<LegendEntry> {
     legend
 }
 
-fn entry(class: &'static str, text: &str) -> LegendEntry {
+pub(super) fn entry(class: &'static str, text: &str) -> LegendEntry {
     LegendEntry {
         class,
         text: text.to_string(),

@@ -1,7 +1,7 @@
 //! The named scenarios: which states move, how far, how fast, and who watches.
 //!
 //! Two set-ups share the world frames:
-//! - *table* (`mouse`, `fast`, `clutter`, `twofinger`): world z up, the table is z = 0; the
+//! - *table* (`mouse`, `mouse-thesis`, `fast`, `clutter`, `twofinger`): world z up, the table is z = 0; the
 //!   hand lies palm-down 45 mm above it, fingers along +y. The mouse camera looks down at 45°
 //!   from behind the wrist (camera and pose copied from the conformance fixture
 //!   `sample-mouse`); the two-finger camera looks down at 50° from in front of the fingertips.
@@ -11,11 +11,13 @@
 use anyhow::{bail, Result};
 
 use super::cameras::look_at;
+use super::mouse_thesis;
 use crate::sequence::CameraFile;
 
 /// Every scenario name, in the order `--help` lists them.
-pub const NAMES: [&str; 7] = [
+pub const NAMES: [&str; 8] = [
     "mouse",
+    "mouse-thesis",
     "rigid",
     "twofinger",
     "fullhand-stereo",
@@ -42,7 +44,8 @@ pub struct Scenario {
     pub amplitudes: Vec<(usize, f64)>,
     /// Palm rotation amplitudes about its own x, y, z axes (rad), when it turns.
     pub rotation: Option<[f64; 3]>,
-    /// The fastest fingertip's image speed at its peak (px/frame, at 640×480).
+    /// The fastest fingertip's image speed at its peak (px/frame, at 640×480); 0 for a
+    /// scripted scenario, whose pace the script and the frame count set.
     pub peak_tip_speed: f64,
     /// Noise standard deviation (grey levels).
     pub noise: f32,
@@ -219,6 +222,19 @@ pub fn scenario(name: &str) -> Result<Scenario> {
             "3D-mouse sub-model: palm slides on the table, finger 1 flexes, finger 4 and thumb abduct; one camera at 45°",
             4.0,
         ),
+        "mouse-thesis" => Scenario {
+            name: mouse_thesis::NAME,
+            summary: "the thesis' 3D-mouse trial in four phases: finger 1 raised and lowered twice, held up while the thumb clicks, palm slides and yaws, all at once (--frames 500: the thesis' pace); one camera at 45°",
+            cameras: vec![table_camera()],
+            base: mouse_thesis::base_pose(table_pose()),
+            free: mouse_thesis::FREE.to_vec(),
+            amplitudes: Vec::new(),
+            rotation: None,
+            peak_tip_speed: 0.0,
+            noise: 2.0,
+            blur: 0.5,
+            clutter: false,
+        },
         "fast" => mouse(
             "fast",
             "the mouse motion, fingertips moving 20 px/frame at the peak",

@@ -5,11 +5,13 @@
 //! speed so the fastest fingertip peaks at the scenario's image speed (in the first camera),
 //! checks the hand stays in view (shrinking the amplitudes for the rare seed whose motion would
 //! leave it), and [`render_scenario`] writes `sequence.json` (`model: "builtin:hand"`), the
-//! frames and `truth.csv` (every state, every frame).
+//! frames and `truth.csv` (every state, every frame). [`mouse_thesis`] is scripted instead of
+//! random: the thesis' four-phase 3D-mouse trial, played whole in any number of frames.
 
 pub mod cameras;
 pub mod catalogue;
 pub mod measure;
+pub mod mouse_thesis;
 pub mod random;
 pub mod trajectory;
 
@@ -43,7 +45,8 @@ pub struct RenderOptions {
     /// Seed of the trajectory, the noise and the clutter.
     pub seed: u64,
     /// Frames to render; `None` for [`DEFAULT_FRAMES`]. The trajectory does not depend on it
-    /// for up to [`DEFAULT_FRAMES`] frames: a shorter sequence is the start of the default one.
+    /// for up to [`DEFAULT_FRAMES`] frames: a shorter sequence is the start of the default one
+    /// (except `mouse-thesis`, which plays its whole trial in however many frames).
     pub frames: Option<usize>,
     /// Noise standard deviation (grey levels).
     pub noise: Option<f32>,
@@ -87,7 +90,7 @@ pub struct Generated {
     pub truth: Vec<Vec<f64>>,
     /// How frames are rendered (camera 0; other cameras draw their own clutter and noise).
     pub settings: RenderSettings,
-    /// Time scale of the trajectory (τ per frame).
+    /// Time scale of the trajectory (τ per frame; for `mouse-thesis`, thesis frames per frame).
     pub time_scale: f64,
     /// Fraction of the scenario's amplitudes used (below 1 when the full motion would have
     /// left the view for this seed).
@@ -140,6 +143,10 @@ pub fn generate_from(scenario: Scenario, opts: &RenderOptions) -> Result<Generat
     let horizon = frames.max(DEFAULT_FRAMES);
     let mut shrink = 1.0;
     let (truth, time_scale, amplitude_factor) = loop {
+        if name == mouse_thesis::NAME {
+            let truth = mouse_thesis::sample(&model, &full_size, &scenario.base, frames)?;
+            break (truth, mouse_thesis::thesis_time(1, frames), 1.0);
+        }
         let motion = Motion::random(
             scenario.base.clone(),
             &amplitudes,

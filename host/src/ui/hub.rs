@@ -3,6 +3,7 @@
 //! server reads it. One mutex, held only to copy a few hundred bytes in or out.
 
 use std::collections::{BTreeMap, VecDeque};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
@@ -141,6 +142,8 @@ struct Inner {
 pub struct Hub {
     model: Model,
     inner: Mutex<Inner>,
+    /// `/api/state` answers served so far.
+    polls_served: AtomicU64,
 }
 
 impl Hub {
@@ -164,6 +167,7 @@ impl Hub {
                     free,
                 },
             }),
+            polls_served: AtomicU64::new(0),
         })
     }
 
@@ -280,6 +284,19 @@ impl Hub {
     /// What the page is told about the model.
     pub fn info(&self) -> ModelInfo {
         self.lock().info.clone()
+    }
+
+    /// The snapshot a page polled for, counted in [`Hub::polls_served`].
+    pub fn polled_snapshot(&self) -> Snapshot {
+        let snapshot = self.snapshot();
+        self.polls_served.fetch_add(1, Ordering::Relaxed);
+        snapshot
+    }
+
+    /// How many snapshots pages have polled for: a test that drives a page can wait until the
+    /// page has seen a state instead of guessing how long that takes.
+    pub fn polls_served(&self) -> u64 {
+        self.polls_served.load(Ordering::Relaxed)
     }
 
     /// Everything the page shows, now.

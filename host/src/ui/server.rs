@@ -236,7 +236,7 @@ fn answer(
             "text/css; charset=utf-8",
         ),
         "/api/model" => json(&hub.info()),
-        "/api/state" => json(&hub.snapshot()),
+        "/api/state" => json(&hub.polled_snapshot()),
         "/frame.png" => match hub.camera_frame() {
             None => text(StatusCode::NOT_FOUND, "no camera frames from this source"),
             Some(frame) => {

@@ -159,49 +159,235 @@ function drawGrid(ctx, cam) {
   }
 }
 
-// ---- the 3D mouse: a top view of the table, the pole's height and the two buttons ----
+// ---- the 3D mouse: the thesis' scene (Sec. 4.3.4, Figs. 4.9 and 4.13) ----
+// A ground plane, the pole standing on it with its shadow, the cursor at the pole's top, and
+// spheres to select: a thumb click with the cursor inside a sphere selects it (highlighted, a
+// line from the cursor to it), a thumb click anywhere else or a finger-4 click drops the
+// selection. Scene units are the pole's millimetres: base (x, y) on the ground, height up.
+// The spheres sit where the demo's trial (`mouse-thesis`) clicks: A where the raised finger
+// holds during the thumb's clicks, B on the path of its last thumb click; C is never clicked.
+const SPHERES = [
+  { name: "A", centre: [0, 0, 48], r: 12, colour: [70, 130, 200] },
+  { name: "B", centre: [-14, 22, 12], r: 12, colour: [90, 170, 90] },
+  { name: "C", centre: [40, 45, 30], r: 12, colour: [170, 110, 190] },
+];
+const GROUND_HALF_MM = 75;
+const GROUND_CHECK_MM = 15;
+// Towards the light: the shadows fall away from it, onto the ground.
+const LIGHT = norm([-0.45, 0.55, 1]);
+const SCENE_EYE = [-45, -170, 125];
+const SCENE_TARGET = [0, 14, 20];
+const THUMB = 1, FINGER4 = 0;
+// What the page saw of the mouse; mirrored as data-* attributes on <body> for tests.
+const mouseState = {
+  buttons: null, selected: null, thumbPresses: 0, finger4Presses: 0, hovered: 0, events: [],
+};
+
+function sceneCamera(canvas) {
+  const eye = SCENE_EYE;
+  const f = norm(sub(SCENE_TARGET, eye));
+  const r = norm(cross(f, [0, 0, 1]));
+  const u = cross(r, f);
+  const F = 1.2 * Math.min(canvas.width, canvas.height);
+  const cx = canvas.width / 2, cy = canvas.height / 2 + 10;
+  return {
+    project(p) {
+      const v = sub(p, eye);
+      const z = dot(v, f);
+      return { x: cx + (F * dot(v, r)) / z, y: cy - (F * dot(v, u)) / z, z, s: F / z };
+    },
+  };
+}
+
+// Where a point's shadow falls on the ground (z = 0).
+const shadowOf = (p) => sub(p, mul(LIGHT, p[2] / LIGHT[2]));
+
+// The sphere the cursor is inside, if any (the nearest centre).
+function sphereAt(cursor) {
+  let best = null, bestD = Infinity;
+  for (const s of SPHERES) {
+    const d = Math.hypot(...sub(cursor, s.centre));
+    if (d <= s.r && d < bestD) { best = s; bestD = d; }
+  }
+  return best;
+}
+
+// Takes in a new mouse reading: counts presses (a button going down) and selects or drops.
+function updateSelection(m) {
+  const cursor = [m.x_mm, m.y_mm, m.height_mm];
+  const over = sphereAt(cursor);
+  if (over) mouseState.hovered += 1;
+  const before = mouseState.buttons;
+  const log = (event) => {
+    mouseState.events.push(event);
+    if (mouseState.events.length > 16) mouseState.events.shift();
+  };
+  if (before) {
+    if (m.buttons[THUMB] && !before[THUMB]) {
+      mouseState.thumbPresses += 1;
+      if (over) log(`select:${over.name}`);
+      else if (mouseState.selected) log("drop:thumb");
+      mouseState.selected = over ? over.name : null;
+    }
+    if (m.buttons[FINGER4] && !before[FINGER4]) {
+      mouseState.finger4Presses += 1;
+      if (mouseState.selected) log("drop:finger4");
+      mouseState.selected = null;
+    }
+  }
+  mouseState.buttons = m.buttons.slice();
+  const body = document.body.dataset;
+  body.mouseSelected = mouseState.selected || "";
+  body.mouseHover = over ? over.name : "";
+  body.mouseHovered = String(mouseState.hovered);
+  body.thumbPresses = String(mouseState.thumbPresses);
+  body.finger4Presses = String(mouseState.finger4Presses);
+  body.mouseEvents = mouseState.events.join(" ");
+  const sel = SPHERES.find((s) => s.name === mouseState.selected);
+  $("mouse-selection").textContent = sel
+    ? `selected: sphere ${sel.name} at (${sel.centre.join(", ")}) mm`
+    : over ? `cursor inside sphere ${over.name}: click the thumb to select it` : "nothing selected";
+}
+
 function drawMouse() {
   const canvas = $("mouse");
   const ctx = canvas.getContext("2d");
-  ctx.clearRect(0, 0, canvas.width, canvas.height);
+  ctx.fillStyle = "#f7f5ee";
+  ctx.fillRect(0, 0, canvas.width, canvas.height);
   const m = snap && snap.mouse;
-  const W = 260, H = 240, ox = 10, oy = 10, range = 100; // ±100 mm around the rest position
-  ctx.strokeStyle = "#bbb";
-  ctx.strokeRect(ox, oy, W, H);
-  ctx.fillStyle = "#888";
-  ctx.font = "11px sans-serif";
-  ctx.fillText("table, top view (±100 mm)", ox + 4, oy + H - 6);
-  if (!m) return;
-  if (!trail.length || trail[trail.length - 1][0] !== m.x_mm || trail[trail.length - 1][1] !== m.y_mm) {
-    trail.push([m.x_mm, m.y_mm]);
-    if (trail.length > 90) trail.shift();
+  if (m) {
+    updateSelection(m);
+    const last = trail[trail.length - 1];
+    if (!last || last[0] !== m.x_mm || last[1] !== m.y_mm) {
+      trail.push([m.x_mm, m.y_mm]);
+      if (trail.length > 90) trail.shift();
+    }
   }
-  const px = (x) => ox + W / 2 + (x / range) * (W / 2);
-  const py = (y) => oy + H / 2 - (y / range) * (H / 2);
-  ctx.strokeStyle = "rgba(230,126,34,0.5)";
-  ctx.beginPath();
-  trail.forEach(([x, y], i) => (i ? ctx.lineTo(px(x), py(y)) : ctx.moveTo(px(x), py(y))));
-  ctx.stroke();
-  ctx.fillStyle = "#e67e22";
-  ctx.beginPath(); ctx.arc(px(m.x_mm), py(m.y_mm), 6, 0, 2 * Math.PI); ctx.fill();
-  // Height bar: 0..80 mm.
-  const bx = ox + W + 20, bh = 180, top = oy + 10;
+  const cam = sceneCamera(canvas);
+  const P = (p) => cam.project(p);
+  const poly = (points) => {
+    ctx.beginPath();
+    points.forEach((p, i) => (i ? ctx.lineTo(p.x, p.y) : ctx.moveTo(p.x, p.y)));
+    ctx.closePath();
+  };
+  // The ground plane: a checkerboard.
+  const n = Math.round((2 * GROUND_HALF_MM) / GROUND_CHECK_MM);
+  for (let i = 0; i < n; i++) {
+    for (let j = 0; j < n; j++) {
+      const x0 = -GROUND_HALF_MM + i * GROUND_CHECK_MM, y0 = -GROUND_HALF_MM + j * GROUND_CHECK_MM;
+      const x1 = x0 + GROUND_CHECK_MM, y1 = y0 + GROUND_CHECK_MM;
+      poly([P([x0, y0, 0]), P([x1, y0, 0]), P([x1, y1, 0]), P([x0, y1, 0])]);
+      ctx.fillStyle = (i + j) % 2 ? "#d9d4c3" : "#e8e3d3";
+      ctx.fill();
+    }
+  }
+  // The base's trail on the ground.
+  if (trail.length > 1) {
+    ctx.strokeStyle = "rgba(230,126,34,0.45)";
+    ctx.lineWidth = 2;
+    ctx.beginPath();
+    trail.forEach(([x, y], i) => { const p = P([x, y, 0]); i ? ctx.lineTo(p.x, p.y) : ctx.moveTo(p.x, p.y); });
+    ctx.stroke();
+  }
+  // Shadows: the spheres' (ellipses on the ground) and the pole's (a line from its base).
+  ctx.fillStyle = "rgba(60,50,40,0.28)";
+  for (const s of SPHERES) {
+    const c = shadowOf(s.centre);
+    const along = norm([-LIGHT[0], -LIGHT[1], 0]);
+    const across = [-along[1], along[0], 0];
+    const stretch = 1 / LIGHT[2];
+    const pts = [];
+    for (let k = 0; k < 24; k++) {
+      const a = (2 * Math.PI * k) / 24;
+      pts.push(P(add(c, add(mul(along, s.r * stretch * Math.cos(a)), mul(across, s.r * Math.sin(a))))));
+    }
+    poly(pts);
+    ctx.fill();
+  }
+  const items = [];
+  if (m) {
+    const base = [m.x_mm, m.y_mm, 0], top = [m.x_mm, m.y_mm, m.height_mm];
+    const b = P(base), t = P(top), sh = P(shadowOf(top));
+    ctx.strokeStyle = "rgba(60,50,40,0.45)";
+    ctx.lineWidth = 3;
+    ctx.beginPath(); ctx.moveTo(b.x, b.y); ctx.lineTo(sh.x, sh.y); ctx.stroke();
+    items.push({
+      depth: t.z,
+      draw() {
+        ctx.strokeStyle = "#444";
+        ctx.lineWidth = 3;
+        ctx.beginPath(); ctx.moveTo(b.x, b.y); ctx.lineTo(t.x, t.y); ctx.stroke();
+        ctx.fillStyle = "#555";
+        ctx.beginPath(); ctx.ellipse(b.x, b.y, 9, 4, 0, 0, 2 * Math.PI); ctx.fill();
+        ctx.fillStyle = "#e67e22";
+        ctx.beginPath(); ctx.arc(t.x, t.y, Math.max(4, 3 * t.s), 0, 2 * Math.PI); ctx.fill();
+        ctx.strokeStyle = "#7a3d00";
+        ctx.lineWidth = 1;
+        ctx.stroke();
+      },
+    });
+  }
+  const hover = m ? sphereAt([m.x_mm, m.y_mm, m.height_mm]) : null;
+  for (const s of SPHERES) {
+    const c = P(s.centre);
+    const selected = s.name === mouseState.selected;
+    items.push({
+      depth: c.z,
+      draw() {
+        const rad = s.r * c.s;
+        const g = ctx.createRadialGradient(c.x - rad / 3, c.y - rad / 3, rad / 8, c.x, c.y, rad);
+        const k = selected ? 1.25 : s === hover ? 1.1 : 0.9;
+        g.addColorStop(0, shade(s.colour, 1.6 * k));
+        g.addColorStop(1, shade(s.colour, 0.7 * k));
+        ctx.fillStyle = g;
+        ctx.beginPath(); ctx.arc(c.x, c.y, rad, 0, 2 * Math.PI); ctx.fill();
+        if (selected || s === hover) {
+          ctx.strokeStyle = selected ? "#c0392b" : "#555";
+          ctx.lineWidth = selected ? 3 : 1.5;
+          ctx.stroke();
+        }
+        ctx.fillStyle = "#333";
+        ctx.font = "12px sans-serif";
+        ctx.fillText(s.name, c.x + rad + 3, c.y - rad + 4);
+      },
+    });
+  }
+  items.sort((p, q) => q.depth - p.depth);
+  for (const it of items) it.draw();
+  // The selection: a line from the cursor to the selected sphere.
+  const sel = SPHERES.find((s) => s.name === mouseState.selected);
+  if (m && sel) {
+    const a = P([m.x_mm, m.y_mm, m.height_mm]), b = P(sel.centre);
+    ctx.strokeStyle = "#c0392b";
+    ctx.lineWidth = 2;
+    ctx.setLineDash([6, 4]);
+    ctx.beginPath(); ctx.moveTo(a.x, a.y); ctx.lineTo(b.x, b.y); ctx.stroke();
+    ctx.setLineDash([]);
+  }
+  // The readings: the pole's height (0..80 mm) and the two buttons.
+  const bx = canvas.width - 86, top = 16, bh = 120;
   ctx.strokeStyle = "#bbb";
-  ctx.strokeRect(bx, top, 24, bh);
-  const h = Math.max(0, Math.min(1, m.height_mm / 80));
+  ctx.strokeRect(bx, top, 18, bh);
+  const h = m ? Math.max(0, Math.min(1, m.height_mm / 80)) : 0;
   ctx.fillStyle = "#e67e22";
-  ctx.fillRect(bx, top + bh * (1 - h), 24, bh * h);
+  ctx.fillRect(bx, top + bh * (1 - h), 18, bh * h);
   ctx.fillStyle = "#555";
-  ctx.fillText("height", bx - 4, top + bh + 14);
-  // Buttons.
+  ctx.font = "11px sans-serif";
+  ctx.fillText("height", bx - 8, top + bh + 14);
   const names = ["finger 4", "thumb"];
-  (m.buttons || []).forEach((on, i) => {
-    const cx = bx + 70, cy = top + 30 + i * 70;
+  names.forEach((name, i) => {
+    const on = !!(m && m.buttons && m.buttons[i]);
+    const cx = bx + 52, cy = top + 16 + i * 58;
     ctx.fillStyle = on ? "#c0392b" : "#ddd";
-    ctx.beginPath(); ctx.arc(cx, cy, 18, 0, 2 * Math.PI); ctx.fill();
+    ctx.beginPath(); ctx.arc(cx, cy, 13, 0, 2 * Math.PI); ctx.fill();
     ctx.fillStyle = "#555";
-    ctx.fillText(names[i], cx - 22, cy + 34);
+    ctx.fillText(name, cx - 20, cy + 27);
   });
+  if (!m) {
+    ctx.fillStyle = "#667";
+    ctx.font = "14px sans-serif";
+    ctx.fillText("no mouse reading", 16, 24);
+  }
 }
 
 // ---- the text panels ----
