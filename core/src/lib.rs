@@ -17,6 +17,8 @@
 //! - [`estimator`]: residuals, row-by-row normal equations, conditioned Gauss–Newton (Eq. 2.22).
 //! - [`motion`]: the prediction between frames, the prior toward it, what a lost frame keeps.
 //! - [`silhouette`]: how well the projected silhouette agrees with the image (region evidence).
+//! - [`search`]: one camera's slice search across a frame's iterations (coarse to fine).
+//! - [`measurer`]: where the loop's features come from: local frames, or one board per camera.
 //! - [`tracker`]: the per-frame loop and its report.
 //! - [`measurement`]: measured axis lines and fingertips at a state, for a stereo host.
 //! - [`protocol`]: the board link's messages and their framing (`docs/protocol.md`).
@@ -35,12 +37,14 @@ pub mod features;
 pub mod frame;
 pub mod kinematics;
 pub mod measurement;
+pub mod measurer;
 pub mod model;
 pub mod model_writer;
 pub mod motion;
 pub mod projection;
 pub mod protocol;
 pub mod quaternion;
+pub mod search;
 pub mod silhouette;
 pub mod tracker;
 pub mod visibility;

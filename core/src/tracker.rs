@@ -10,13 +10,14 @@ use core::fmt;
 use heapless::Vec;
 
 use crate::camera::{Camera, CameraError};
-use crate::config::{MAX_CAMERAS, MAX_FRAMES, MAX_STATES};
+use crate::config::{MAX_CAMERAS, MAX_STATES};
 use crate::estimator::{
     add_link_rows, apply_step, EstimatorConfig, FreeMask, LinkJacobian, NormalEquations,
 };
-use crate::features::{find_link_features, FeatureConfig, LinkFeatures};
+use crate::features::{FeatureConfig, LinkFeatures};
 use crate::frame::{FrameError, FrameView};
 use crate::kinematics::{KinematicsError, Poses};
+use crate::measurer::{LocalFrames, Measurer};
 use crate::model::Model;
 use crate::motion::{velocity_trust, MotionConfig};
 use crate::projection::ProjectedModel;
@@ -157,9 +158,6 @@ struct Workspace {
     features: LinkFeatures,
     jacobian: LinkJacobian,
     normal: NormalEquations,
-    /// `reach[camera][frame]`: what the last search of link `frame` in this frame needed
-    /// ([`LinkFeatures::reach_px`]), infinite when unknown; sizes the next window.
-    reach: [[f32; MAX_FRAMES]; MAX_CAMERAS],
 }
 
 /// Tracks one hand over frames from one or more calibrated cameras.
@@ -223,7 +221,6 @@ impl Tracker {
                 features: LinkFeatures::default(),
                 jacobian: LinkJacobian::default(),
                 normal: NormalEquations::new(),
-                reach: [[f32::INFINITY; MAX_FRAMES]; MAX_CAMERAS],
             },
         };
         tracker.reset(initial)?;
@@ -241,7 +238,6 @@ impl Tracker {
         let cameras = checked_cameras(cameras)?;
         self.cameras = cameras;
         self.config = config;
-        self.work.reach = [[f32::INFINITY; MAX_FRAMES]; MAX_CAMERAS];
         Ok(())
     }
 
@@ -300,13 +296,22 @@ impl Tracker {
                 }));
             }
         }
+        self.track_with(&mut LocalFrames::new(frames))
+    }
+
+    /// Tracks one instant with features from `measurer` (one camera per entry of
+    /// [`Tracker::cameras`]): [`Tracker::track`] with the frames elsewhere, e.g. one board per
+    /// camera. The same loop, so the same features give the same state.
+    pub fn track_with<M: Measurer>(
+        &mut self,
+        measurer: &mut M,
+    ) -> Result<FrameReport, TrackerError> {
         let start = self.state.clone();
         let predicted = self.predicted();
         let mut q = predicted.clone();
         let mut report = FrameReport::default();
-        self.work.reach = [[f32::INFINITY; MAX_FRAMES]; MAX_CAMERAS];
         for k in 0..self.config.iterations.max(1) {
-            let Some(step) = self.iterate(&q, &predicted, frames, k > 0, &mut report) else {
+            let Some(step) = self.iterate(&q, &predicted, measurer, k > 0, &mut report) else {
                 report.lost = true;
                 break;
             };
@@ -316,7 +321,7 @@ impl Tracker {
                 break;
             }
         }
-        report.silhouette_agreement = self.silhouette_agreement(frames);
+        report.silhouette_agreement = self.silhouette_agreement(measurer);
         let drop = self.config.lost_silhouette_drop;
         if drop > 0.0 {
             let reference = *self
@@ -407,15 +412,15 @@ impl Tracker {
 
     /// The smallest silhouette agreement over the cameras, with the views of the last
     /// iteration (1 when no camera can be scored or the check is off).
-    fn silhouette_agreement(&self, frames: &[FrameView<'_>]) -> f32 {
+    fn silhouette_agreement<M: Measurer>(&self, measurer: &mut M) -> f32 {
         if self.config.silhouette_grid == 0 {
             return 1.0;
         }
         let mut least = 1.0f32;
-        for ((view, camera), frame) in self.work.views.iter().zip(&self.cameras).zip(frames) {
-            let grid = usize::from(self.config.silhouette_grid);
-            if let Some(score) = crate::silhouette::score(view, camera, frame, grid) {
-                least = least.min(score.agreement);
+        let grid = usize::from(self.config.silhouette_grid);
+        for (index, (camera, view)) in self.cameras.iter().zip(&self.work.views).enumerate() {
+            if let Some(agreement) = measurer.silhouette(index, camera, view, grid) {
+                least = least.min(agreement);
             }
         }
         least
@@ -441,28 +446,25 @@ impl Tracker {
     }
 
     /// One Gauss–Newton iteration at `q`: the step, or `None` when no step can be taken.
-    fn iterate(
+    fn iterate<M: Measurer>(
         &mut self,
         q: &[f32],
         predicted: &[f32],
-        frames: &[FrameView<'_>],
+        measurer: &mut M,
         refine: bool,
         report: &mut FrameReport,
     ) -> Option<nalgebra::SVector<f32, MAX_STATES>> {
         let work = &mut self.work;
         work.poses.update(&self.model, q).ok()?;
+        measurer.begin_iteration(q, refine);
         work.normal.clear();
         report.features_found = 0;
         report.features_expected = 0;
         report.features_masked = 0;
         report.links_skipped = 0;
         let config = &self.config;
-        for (((camera, frame), view), reach) in self
-            .cameras
-            .iter()
-            .zip(frames.iter())
-            .zip(work.views.iter_mut())
-            .zip(work.reach.iter_mut())
+        for (camera_index, (camera, view)) in
+            self.cameras.iter().zip(work.views.iter_mut()).enumerate()
         {
             view.update(
                 &self.model,
@@ -473,29 +475,20 @@ impl Tracker {
             let skipped = view.skipped;
             report.links_skipped += skipped.behind + skipped.end_on + skipped.off_frame;
             for index in 0..view.links.len() {
-                let frame_index = usize::from(view.links[index].frame);
-                let mut features = config.features;
-                if refine {
-                    // Coarse to fine: the window this link's last search needed, plus margin.
-                    let reach = reach.get(frame_index).copied().unwrap_or(f32::INFINITY);
-                    let need = 2.0 * (reach + features.refine_margin_px) + 7.0;
-                    if need < f32::from(features.window_px) {
-                        features.window_px = libm::ceilf(need) as u8;
-                    }
-                }
-                find_link_features(view, camera, frame, index, &features, &mut work.features);
+                measurer.link_features(
+                    camera_index,
+                    camera,
+                    view,
+                    index,
+                    &config.features,
+                    refine,
+                    &mut work.features,
+                );
                 let found =
                     work.features.edges.len() as u16 + u16::from(work.features.tip.is_some());
                 report.features_found += found;
                 report.features_expected += work.features.expected;
                 report.features_masked += work.features.masked;
-                if let Some(r) = reach.get_mut(frame_index) {
-                    *r = if found == 0 {
-                        f32::INFINITY
-                    } else {
-                        work.features.reach_px
-                    };
-                }
                 if found == 0 {
                     continue;
                 }

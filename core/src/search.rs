@@ -1,0 +1,85 @@
+//! One camera's slice search across the iterations of a frame: the first iteration searches
+//! every link with the configured window; later ones narrow each link's window to what its
+//! last search needed (coarse to fine), so a frame's later iterations cost less.
+//!
+//! The in-process tracker keeps one per camera; a board measuring for a stereo host
+//! ([`measurer`](crate::measurer)) keeps its own, so both narrow the windows alike.
+
+use crate::camera::Camera;
+use crate::config::MAX_FRAMES;
+use crate::features::{find_link_features, FeatureConfig, LinkFeatures};
+use crate::frame::FrameView;
+use crate::projection::ProjectedModel;
+
+/// Pixels added to a narrowed window beyond twice the reach and margin, so the window still
+/// holds the edge filter's support (the 7-sample minimum of a window).
+pub const WINDOW_MIN_PX: f32 = 7.0;
+
+/// The reach of each link's last search in the current frame.
+#[derive(Debug, Clone, Copy)]
+pub struct CameraSearch {
+    /// `reach_px[link]`: how far from its prediction the last search of model link `link`
+    /// found something ([`LinkFeatures::reach_px`], px); infinite when unknown.
+    reach_px: [f32; MAX_FRAMES],
+}
+
+impl Default for CameraSearch {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl CameraSearch {
+    /// A search that knows nothing yet: every window at its configured width.
+    pub const fn new() -> Self {
+        CameraSearch {
+            reach_px: [f32::INFINITY; MAX_FRAMES],
+        }
+    }
+
+    /// Forgets the reaches: the next searches use the configured windows (a new frame).
+    pub fn restart(&mut self) {
+        self.reach_px = [f32::INFINITY; MAX_FRAMES];
+    }
+
+    /// Searches link `index` of `view` on `frame` into `out`. With `refine`, the window is
+    /// narrowed to what this link's last search needed plus `config.refine_margin_px`.
+    /// Returns the features found (edges and tip).
+    pub fn link(
+        &mut self,
+        view: &ProjectedModel,
+        camera: &Camera,
+        frame: &FrameView<'_>,
+        index: usize,
+        config: &FeatureConfig,
+        refine: bool,
+        out: &mut LinkFeatures,
+    ) -> u16 {
+        let link_frame = view
+            .links
+            .get(index)
+            .map_or(usize::MAX, |l| usize::from(l.frame));
+        let mut features = *config;
+        if refine {
+            let reach = self
+                .reach_px
+                .get(link_frame)
+                .copied()
+                .unwrap_or(f32::INFINITY);
+            let need = 2.0 * (reach + features.refine_margin_px) + WINDOW_MIN_PX;
+            if need < f32::from(features.window_px) {
+                features.window_px = libm::ceilf(need) as u8;
+            }
+        }
+        find_link_features(view, camera, frame, index, &features, out);
+        let found = out.edges.len() as u16 + u16::from(out.tip.is_some());
+        if let Some(r) = self.reach_px.get_mut(link_frame) {
+            *r = if found == 0 {
+                f32::INFINITY
+            } else {
+                out.reach_px
+            };
+        }
+        found
+    }
+}
