@@ -45,6 +45,7 @@ impl CameraSearch {
     /// Searches link `index` of `view` on `frame` into `out`. With `refine`, the window is
     /// narrowed to what this link's last search needed plus `config.refine_margin_px`.
     /// Returns the features found (edges and tip).
+    #[allow(clippy::too_many_arguments)]
     pub fn link(
         &mut self,
         view: &ProjectedModel,
