@@ -19,6 +19,7 @@
 //! - [`silhouette`]: how well the projected silhouette agrees with the image (region evidence).
 //! - [`search`]: one camera's slice search across a frame's iterations (coarse to fine).
 //! - [`measurer`]: where the loop's features come from: local frames, or one board per camera.
+//! - [`remote`]: a board's answer to a stereo host's `Measure`, and its features on the wire.
 //! - [`tracker`]: the per-frame loop and its report.
 //! - [`measurement`]: measured axis lines and fingertips at a state, for a stereo host.
 //! - [`protocol`]: the board link's messages and their framing (`docs/protocol.md`).
@@ -44,6 +45,7 @@ pub mod motion;
 pub mod projection;
 pub mod protocol;
 pub mod quaternion;
+pub mod remote;
 pub mod search;
 pub mod silhouette;
 pub mod tracker;

@@ -99,6 +99,31 @@ fn board_messages() -> std::vec::Vec<BoardMessage> {
         BoardMessage::Ack(Command::Configure),
         BoardMessage::Nak(Command::Reset, Refusal::BadFreeMask),
         BoardMessage::Pong(0x0102_0304),
+        // The largest answer to a Measure: every edge a link can have, worst-case varints.
+        BoardMessage::LinkEdges(LinkEdges {
+            frame: u32::MAX,
+            iteration: u8::MAX,
+            index: u8::MAX,
+            link: u8::MAX,
+            edges: (0..digiteyes_core::features::MAX_LINK_EDGES)
+                .map(|i| WireEdge {
+                    s: i as f32 / 7.0,
+                    side: -1,
+                    position: [f32::MAX, f32::MIN],
+                })
+                .collect(),
+            tip: Some([f32::MAX, f32::MIN]),
+            expected: u16::MAX,
+            masked: u16::MAX,
+        }),
+        BoardMessage::Measured(Measured {
+            frame: u32::MAX,
+            iteration: u8::MAX,
+            held: false,
+            links: u8::MAX,
+            silhouette: Some(f32::NAN),
+        }),
+        BoardMessage::Ack(Command::Hold),
     ]
 }
 
@@ -122,6 +147,12 @@ fn host_messages(data: &[u8]) -> std::vec::Vec<HostMessage<'_>> {
             data,
         }),
         HostMessage::Ping(u32::MAX),
+        HostMessage::Hold,
+        HostMessage::Measure(Measure {
+            frame: u32::MAX,
+            iteration: u8::MAX,
+            q: full_q(32),
+        }),
     ]
 }
 

@@ -43,6 +43,15 @@ fn host_messages(data: &[u8]) -> Vec<(&'static str, HostMessage<'_>)> {
             }),
         ),
         ("Ping", HostMessage::Ping(0x0102_0304)),
+        ("Hold", HostMessage::Hold),
+        (
+            "Measure",
+            HostMessage::Measure(Measure {
+                frame: 9,
+                iteration: 1,
+                q: heapless::Vec::from_slice(&[1.0, 0.0, 0.0, 0.0, 5.0, -2.5, 400.0]).unwrap(),
+            }),
+        ),
     ]
 }
 
@@ -69,7 +78,7 @@ fn board_messages() -> Vec<(&'static str, BoardMessage)> {
         (
             "Hello",
             BoardMessage::Hello(Hello {
-                version: 2,
+                version: 3,
                 board: heapless::String::try_from("qemu-m7").unwrap(),
                 model_digest: 0xd4f6_1ba4,
                 clock_hz: 25_000_000,
@@ -144,6 +153,34 @@ fn board_messages() -> Vec<(&'static str, BoardMessage)> {
             BoardMessage::Nak(Command::Configure, Refusal::BadParameters),
         ),
         ("Pong", BoardMessage::Pong(0x0102_0304)),
+        (
+            "LinkEdges",
+            BoardMessage::LinkEdges(LinkEdges {
+                frame: 9,
+                iteration: 1,
+                index: 2,
+                link: 5,
+                edges: heapless::Vec::from_slice(&[WireEdge {
+                    s: 0.5,
+                    side: -1,
+                    position: [10.0, 20.0],
+                }])
+                .unwrap(),
+                tip: Some([12.5, 30.0]),
+                expected: 3,
+                masked: 1,
+            }),
+        ),
+        (
+            "Measured",
+            BoardMessage::Measured(Measured {
+                frame: 9,
+                iteration: 1,
+                held: true,
+                links: 1,
+                silhouette: Some(0.75),
+            }),
+        ),
     ]
 }
 
@@ -174,6 +211,12 @@ fn golden_host(name: &str) -> &'static [u8] {
         "Ping" => &[
             0x00, 0x0a, 0x03, 0x84, 0x86, 0x88, 0x08, 0xe2, 0x51, 0x80, 0xfb, 0x00,
         ],
+        "Hold" => &[0x00, 0x06, 0x04, 0x94, 0x2b, 0x6f, 0xd5, 0x00],
+        "Measure" => &[
+            0x00, 0x05, 0x05, 0x09, 0x01, 0x07, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x01, 0x01, 0x01,
+            0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x03, 0xa0, 0x40, 0x01, 0x03,
+            0x20, 0xc0, 0x01, 0x07, 0xc8, 0x43, 0x3c, 0x69, 0xa6, 0x03, 0x00,
+        ],
         _ => unreachable!("no golden frame for {name}"),
     }
 }
@@ -181,9 +224,9 @@ fn golden_host(name: &str) -> &'static [u8] {
 fn golden_board(name: &str) -> &'static [u8] {
     match name {
         "Hello" => &[
-            0x00, 0x01, 0x21, 0x02, 0x07, 0x71, 0x65, 0x6d, 0x75, 0x2d, 0x6d, 0x37, 0xa4, 0xb7,
+            0x00, 0x01, 0x21, 0x03, 0x07, 0x71, 0x65, 0x6d, 0x75, 0x2d, 0x6d, 0x37, 0xa4, 0xb7,
             0xd8, 0xa7, 0x0d, 0xc0, 0xf0, 0xf5, 0x0b, 0x1c, 0x20, 0x30, 0x80, 0xe0, 0x12, 0x80,
-            0x08, 0x80, 0x0b, 0x97, 0x0c, 0x65, 0xbf, 0x00,
+            0x08, 0x80, 0x0b, 0x8a, 0xf1, 0xd0, 0xbe, 0x00,
         ],
         "State" => &[
             0x00, 0x06, 0x01, 0x07, 0xe8, 0x07, 0x03, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x01, 0x01,
@@ -207,6 +250,15 @@ fn golden_board(name: &str) -> &'static [u8] {
         "Pong" => &[
             0x00, 0x08, 0x07, 0x84, 0x86, 0x88, 0x08, 0x22, 0xf7, 0x02, 0x0e, 0x00,
         ],
+        "LinkEdges" => &[
+            0x00, 0x07, 0x08, 0x09, 0x01, 0x02, 0x05, 0x01, 0x01, 0x01, 0x03, 0x3f, 0xff, 0x01,
+            0x03, 0x20, 0x41, 0x01, 0x04, 0xa0, 0x41, 0x01, 0x01, 0x03, 0x48, 0x41, 0x01, 0x09,
+            0xf0, 0x41, 0x03, 0x01, 0x79, 0xae, 0x6a, 0x6d, 0x00,
+        ],
+        "Measured" => &[
+            0x00, 0x07, 0x09, 0x09, 0x01, 0x01, 0x01, 0x01, 0x01, 0x07, 0x40, 0x3f, 0xe0, 0x66,
+            0xc2, 0x69, 0x00,
+        ],
         _ => unreachable!("no golden frame for {name}"),
     }
 }
@@ -217,7 +269,7 @@ fn every_host_message_encodes_to_its_golden_bytes_and_back() {
     let messages = host_messages(&PIXELS);
     assert_eq!(
         messages.len(),
-        4,
+        6,
         "one golden frame per HostMessage variant"
     );
     for (name, message) in messages {
@@ -236,7 +288,7 @@ fn every_board_message_encodes_to_its_golden_bytes_and_back() {
     let messages = board_messages();
     assert_eq!(
         messages.len(),
-        8,
+        10,
         "one golden frame per BoardMessage variant"
     );
     for (name, message) in messages {
@@ -306,4 +358,16 @@ fn the_digest_of_the_worked_example_is_the_crc_of_the_bytes_in_the_spec() {
     assert_eq!(model_digest(&Model::hand().unwrap()), 0x02f9_1b5a);
     let respelled = tiny.replace("0 30 0", "0 3e1 0").replace(" f ", " finger ");
     assert_eq!(model_digest(&Model::parse(&respelled).unwrap()), crc);
+}
+
+#[test]
+#[ignore = "prints the golden bytes of every message, for a deliberate layout change"]
+fn print_golden_bytes() {
+    let mut buf = [0u8; MAX_MESSAGE];
+    for (name, m) in host_messages(&PIXELS) {
+        println!("host {name}: {:02x?}", encode(&m, &mut buf).unwrap());
+    }
+    for (name, m) in board_messages() {
+        println!("board {name}: {:02x?}", encode(&m, &mut buf).unwrap());
+    }
 }

@@ -8,9 +8,10 @@ use digiteyes_core::measurement::measure_links;
 use digiteyes_core::model::Model;
 use digiteyes_core::protocol::{
     encode, model_digest, BoardMessage, Capacities, Command, Configure, Decoder, DropReason,
-    Dropped, Features, FrameChunk, Hello, HostMessage, Refusal, Reset, State, Stats, MAX_CHUNK,
-    MAX_MESSAGE, PROTOCOL_VERSION,
+    Dropped, Features, FrameChunk, Hello, HostMessage, Measure, Measured, Refusal, Reset, State,
+    Stats, MAX_CHUNK, MAX_MESSAGE, PROTOCOL_VERSION,
 };
+use digiteyes_core::remote::MeasureWork;
 use digiteyes_core::tracker::{FrameReport, Tracker, TrackerConfig, TrackerError};
 use embedded_hal::delay::DelayNs;
 use embedded_hal::digital::OutputPin;
@@ -74,6 +75,10 @@ struct Node<'m, S, F, L, C> {
     tx: [u8; MAX_MESSAGE],
     setup: Option<Setup>,
     tracker: Option<Tracker>,
+    /// Set by `Hold`: complete frames are held for `Measure` instead of tracked.
+    measuring: Option<MeasureWork>,
+    /// The frame held for `Measure`: the last one completed while measuring.
+    held: Option<u32>,
     upload: Upload,
     stats: Stats,
 }
@@ -119,6 +124,8 @@ where
                 tx: [0; MAX_MESSAGE],
                 setup: None,
                 tracker: None,
+                measuring: None,
+                held: None,
                 upload: Upload::new(),
                 stats: Stats::default(),
             },
@@ -219,7 +226,71 @@ where
                 self.send(&BoardMessage::Stats(stats))?;
                 self.send(&BoardMessage::Pong(token))
             }
+            HostMessage::Hold => self.hold(),
+            HostMessage::Measure(measure) => self.measure(&measure),
         }
+    }
+
+    /// Leaves tracking for measuring: frames are held for `Measure` (one board per camera).
+    #[inline(never)]
+    fn hold(&mut self) -> Result<(), S::Error> {
+        if self.setup.is_none() {
+            return self.send(&BoardMessage::Nak(Command::Hold, Refusal::NotConfigured));
+        }
+        self.tracker = None;
+        if self.measuring.is_none() {
+            self.measuring = Some(MeasureWork::new());
+        }
+        self.held = None;
+        self.abandon_upload()?;
+        self.send(&BoardMessage::Ack(Command::Hold))
+    }
+
+    /// Searches the held frame at the host's state and sends what each link showed.
+    fn measure(&mut self, measure: &Measure) -> Result<(), S::Error> {
+        let not_held = Measured {
+            frame: measure.frame,
+            iteration: measure.iteration,
+            held: false,
+            links: 0,
+            silhouette: None,
+        };
+        let ready = !self.upload.in_progress() && self.held == Some(measure.frame);
+        let (Some(setup), Some(work), Some(model), true) = (
+            self.setup,
+            self.measuring.as_mut(),
+            self.model.as_ref(),
+            ready,
+        ) else {
+            return self.send(&BoardMessage::Measured(not_held));
+        };
+        let (w, h) = (setup.camera.width as usize, setup.camera.height as usize);
+        let pixels = self.frame.get(..w * h).unwrap_or_default();
+        let Ok(view) = FrameView::packed(pixels, w, h) else {
+            return self.send(&BoardMessage::Measured(not_held));
+        };
+        let (tx, serial, stats) = (&mut self.tx, &mut self.serial, &mut self.stats);
+        let mut failed = None;
+        let answer = work.measure(
+            model,
+            &setup.camera,
+            &view,
+            &setup.config,
+            measure,
+            |edges| {
+                if failed.is_none() {
+                    if let Err(e) =
+                        send_on(serial, tx, stats, &BoardMessage::LinkEdges(edges.clone()))
+                    {
+                        failed = Some(e);
+                    }
+                }
+            },
+        );
+        if let Some(e) = failed {
+            return Err(e);
+        }
+        self.send(&BoardMessage::Measured(answer))
     }
 
     // Set-up builds a ~30 KB tracker by value; kept out of line so that the frame path does
@@ -275,6 +346,8 @@ where
         match built {
             Ok(tracker) => {
                 self.tracker = Some(tracker);
+                self.measuring = None;
+                self.held = None;
                 self.abandon_upload()?;
                 self.hello()?;
                 self.send(&BoardMessage::Ack(Command::Reset))
@@ -317,13 +390,18 @@ where
     }
 
     fn chunk(&mut self, chunk: &FrameChunk<'_>) -> Result<(), S::Error> {
-        let expected = match (&self.setup, &self.tracker) {
-            (Some(setup), Some(_)) => {
+        let engaged = self.tracker.is_some() || self.measuring.is_some();
+        let expected = match (&self.setup, engaged) {
+            (Some(setup), true) => {
                 let (w, h) = (setup.camera.width, setup.camera.height);
                 Some((w as u16, h as u16))
             }
             _ => None,
         };
+        if self.held != Some(chunk.frame) {
+            // The buffer is being overwritten: the frame held so far is gone.
+            self.held = None;
+        }
         let (superseded, outcome) = self.upload.accept(chunk, expected, self.frame);
         if let Some(dropped) = superseded {
             self.report_drop(dropped)?;
@@ -335,6 +413,10 @@ where
                 Ok(())
             }
             ChunkOutcome::Dropped(dropped) => self.report_drop(dropped),
+            ChunkOutcome::Complete { frame, .. } if self.measuring.is_some() => {
+                self.held = Some(frame);
+                Ok(())
+            }
             ChunkOutcome::Complete { frame, .. } => self.track(frame),
         }
     }
@@ -480,16 +562,7 @@ where
     }
 
     fn send(&mut self, message: &BoardMessage) -> Result<(), S::Error> {
-        match encode(message, &mut self.tx) {
-            Ok(bytes) => {
-                self.serial.write_all(bytes)?;
-                self.serial.flush()
-            }
-            Err(_) => {
-                self.stats.capacity_overflows += 1;
-                Ok(())
-            }
-        }
+        send_on(&mut self.serial, &mut self.tx, &mut self.stats, message)
     }
 
     fn set_led(&mut self, on: bool) {
@@ -499,5 +572,25 @@ where
         } else {
             self.led.set_low()
         };
+    }
+}
+
+/// Encodes `message` into `tx` and writes it to `serial`; a message too large for `tx` is
+/// counted in `stats.capacity_overflows`, not sent.
+fn send_on<S: Write>(
+    serial: &mut S,
+    tx: &mut [u8; MAX_MESSAGE],
+    stats: &mut Stats,
+    message: &BoardMessage,
+) -> Result<(), S::Error> {
+    match encode(message, tx) {
+        Ok(bytes) => {
+            serial.write_all(bytes)?;
+            serial.flush()
+        }
+        Err(_) => {
+            stats.capacity_overflows += 1;
+            Ok(())
+        }
     }
 }

@@ -47,6 +47,7 @@ pub mod scenarios;
 pub mod sequence;
 pub mod sim;
 pub mod state_names;
+pub mod stereo;
 pub mod stream;
 pub mod text;
 pub mod track;

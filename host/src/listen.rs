@@ -162,6 +162,21 @@ pub fn describe(message: &BoardMessage) -> String {
         BoardMessage::Ack(c) => format!("ack {c:?}"),
         BoardMessage::Nak(c, r) => format!("nak {c:?}: {r:?}"),
         BoardMessage::Pong(t) => format!("pong {t}"),
+        BoardMessage::LinkEdges(e) => format!(
+            "link edges {} (iteration {}): link {}, {} edges{}",
+            e.frame,
+            e.iteration,
+            e.link,
+            e.edges.len(),
+            if e.tip.is_some() { ", tip" } else { "" }
+        ),
+        BoardMessage::Measured(m) => format!(
+            "measured {} (iteration {}): {} links{}",
+            m.frame,
+            m.iteration,
+            m.links,
+            if m.held { "" } else { ", frame not held" }
+        ),
     }
 }
 

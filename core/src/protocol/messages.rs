@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::params::{CameraParams, TrackerParams};
 use crate::config::{MAX_FRAMES, MAX_STATES};
+use crate::features::MAX_LINK_EDGES;
 
 /// Longest board name in [`Hello`] (bytes of UTF-8).
 pub const MAX_BOARD_NAME: usize = 24;
@@ -35,6 +36,11 @@ pub enum BoardMessage {
     Nak(Command, Refusal),
     /// The answer to [`HostMessage::Ping`], carrying its token.
     Pong(u32),
+    /// What the search of one link found, in answer to [`HostMessage::Measure`]
+    /// (version 3).
+    LinkEdges(LinkEdges),
+    /// The end of the answer to a [`HostMessage::Measure`] (version 3).
+    Measured(Measured),
 }
 
 /// Host → board.
@@ -50,6 +56,14 @@ pub enum HostMessage<'a> {
     /// Asks for a [`BoardMessage::Stats`] and a [`BoardMessage::Pong`] with this token, sent
     /// after everything the board received before the ping has been handled.
     Ping(u32),
+    /// From now on hold each complete frame for [`HostMessage::Measure`] instead of tracking
+    /// it (the board forgets its tracker; a `Reset` makes it track again). Answered by
+    /// `Ack(Hold)`, or `Nak(Hold, NotConfigured)` before a `Configure` (version 3).
+    Hold,
+    /// Search the held frame at a state and send what was found: a
+    /// [`BoardMessage::LinkEdges`] per link with anything to say, then
+    /// [`BoardMessage::Measured`] (version 3).
+    Measure(Measure),
 }
 
 /// The host commands that are answered by [`BoardMessage::Ack`] or [`BoardMessage::Nak`].
@@ -60,6 +74,8 @@ pub enum Command {
     Reset,
     /// [`HostMessage::Configure`].
     Configure,
+    /// [`HostMessage::Hold`] (version 3).
+    Hold,
 }
 
 /// Why a command was refused.
@@ -291,4 +307,69 @@ pub struct FrameChunk<'a> {
     pub offset: u32,
     /// The bytes (at most [`MAX_CHUNK`](super::MAX_CHUNK)).
     pub data: &'a [u8],
+}
+
+/// Search the held frame `frame` at state `q` (one iteration of a stereo host's loop).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Measure {
+    /// The frame to search: the last one uploaded and complete.
+    pub frame: u32,
+    /// The iteration of the host's loop on this frame, from 0: the first searches with the
+    /// configured windows, later ones narrow each link's window to what its last search on
+    /// this frame needed. Echoed in the answer, so a late answer is never taken for another.
+    pub iteration: u8,
+    /// The state to search at: every model state (quaternion, mm, rad).
+    pub q: Vec<f32, MAX_STATES>,
+}
+
+/// One silhouette edge point found on a slice (a [`features::EdgePoint`](crate::features::EdgePoint)
+/// without its strength, which no estimate uses).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct WireEdge {
+    /// Where the slice crosses the axis, as a fraction of the axis from its base to its tip.
+    pub s: f32,
+    /// The side of the axis: +1 or −1.
+    pub side: i8,
+    /// The edge in the image (px).
+    pub position: [f32; 2],
+}
+
+/// What the search of one link found (its `LinkFeatures`, as the in-process tracker uses
+/// them), in answer to a [`Measure`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LinkEdges {
+    /// The frame searched.
+    pub frame: u32,
+    /// The [`Measure::iteration`] answered.
+    pub iteration: u8,
+    /// The link's place among the links in view at the measured state (table order).
+    pub index: u8,
+    /// The model frame (link) it is.
+    pub link: u8,
+    /// The edge points found, in search order.
+    pub edges: Vec<WireEdge, MAX_LINK_EDGES>,
+    /// The fingertip found (px), for a distal link.
+    pub tip: Option<[f32; 2]>,
+    /// Edges and tips the model predicted visible and in the frame.
+    pub expected: u16,
+    /// Predicted edges and tips hidden by a nearer part of the hand.
+    pub masked: u16,
+}
+
+/// The end of an answer to a [`Measure`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Measured {
+    /// The frame asked for.
+    pub frame: u32,
+    /// The [`Measure::iteration`] answered.
+    pub iteration: u8,
+    /// Whether the board holds that frame; `false`: nothing was searched.
+    pub held: bool,
+    /// [`LinkEdges`] messages sent for this measure.
+    pub links: u8,
+    /// The silhouette agreement at the measured state (0..=1), when the tracker parameters
+    /// ask for it (`silhouette_grid` > 0) and it can be scored.
+    pub silhouette: Option<f32>,
 }

@@ -25,7 +25,9 @@ pub use params::{BadParameter, CameraParams, TrackerParams, WireResidual, WireRo
 /// The protocol version in [`Hello`]; it rises whenever a message's layout changes.
 /// Version 2: `Stats` gained `stale_chunks`, and the model digest is computed over the
 /// canonical form of `docs/protocol.md` §7 (version 1 digested `write_dh`'s text).
-pub const PROTOCOL_VERSION: u8 = 2;
+/// Version 3: `Hold` and `Measure` (host), `LinkEdges` and `Measured` (board), `Command::Hold`:
+/// one board per camera, measuring for a host that solves (docs/protocol.md §9).
+pub const PROTOCOL_VERSION: u8 = 3;
 
 /// Largest `FrameChunk` payload (bytes).
 pub const MAX_CHUNK: usize = 1024;

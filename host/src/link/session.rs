@@ -84,16 +84,31 @@ impl Session {
         &self.link
     }
 
-    /// Uploads frame `frame` (`width × height` bytes of packed 8-bit grey) and waits for its
-    /// answer. Any size is sent: the board refuses sizes other than its camera's
-    /// (`Dropped{WrongSize}`).
-    pub fn track(
-        &mut self,
-        frame: u32,
-        pixels: &[u8],
-        width: u16,
-        height: u16,
-    ) -> Result<FrameOutcome> {
+    /// The link, to send and receive what this session does not (a stereo host's
+    /// `Measure`s).
+    pub fn link_mut(&mut self) -> &mut Link {
+        &mut self.link
+    }
+
+    /// Sends `Hold` until acknowledged: from now on the board holds each uploaded frame for
+    /// `Measure` instead of tracking it (one board per camera).
+    pub fn hold(&mut self) -> Result<()> {
+        self.command(&HostMessage::Hold, Command::Hold).map(|_| ())
+    }
+
+    /// Sets the board up again after it rebooted (its `Hello` came unasked, already checked
+    /// by the caller): `Configure`, `Reset` from the last state, then `Hold`.
+    pub fn hold_again(&mut self, hello: Hello) -> Result<()> {
+        self.check_hello(&hello)?;
+        self.report.restarts += 1;
+        let q = self.last_state.clone();
+        self.hello = self.handshake(&q, Some(hello))?;
+        self.hold()
+    }
+
+    /// Uploads frame `frame` as `FrameChunk`s without waiting for an answer (a holding board
+    /// sends none).
+    pub fn upload(&mut self, frame: u32, pixels: &[u8], width: u16, height: u16) -> Result<()> {
         let mut offset = 0usize;
         for data in pixels.chunks(MAX_CHUNK) {
             self.link.send(&HostMessage::FrameChunk(FrameChunk {
@@ -105,6 +120,25 @@ impl Session {
             }))?;
             offset += data.len();
         }
+        Ok(())
+    }
+
+    /// Notes the state the host estimated, to restart the board from after a reboot.
+    pub fn note_state(&mut self, q: &[f32]) {
+        self.last_state = q.to_vec();
+    }
+
+    /// Uploads frame `frame` (`width × height` bytes of packed 8-bit grey) and waits for its
+    /// answer. Any size is sent: the board refuses sizes other than its camera's
+    /// (`Dropped{WrongSize}`).
+    pub fn track(
+        &mut self,
+        frame: u32,
+        pixels: &[u8],
+        width: u16,
+        height: u16,
+    ) -> Result<FrameOutcome> {
+        self.upload(frame, pixels, width, height)?;
         let outcome = self.await_answer(frame)?;
         self.report.count(&outcome);
         if let FrameOutcome::Tracked(state) = &outcome {
@@ -233,6 +267,7 @@ impl Session {
             BoardMessage::Stats(stats) => self.report.board = Some(stats),
             BoardMessage::State(_) | BoardMessage::Dropped(_) => self.report.late_answers += 1,
             BoardMessage::Features(_) => self.report.features += 1,
+            BoardMessage::LinkEdges(_) | BoardMessage::Measured(_) => self.report.late_answers += 1,
             BoardMessage::Hello(hello) => {
                 self.check_hello(&hello)?;
                 self.hello = hello;
@@ -339,7 +374,7 @@ fn refusal_text(refusal: Refusal) -> &'static str {
         Refusal::FrameTooLarge => "the camera's frames do not fit the board's frame buffer",
         Refusal::BadState => "the state has the wrong length for the model or is not finite",
         Refusal::BadFreeMask => "a free state is not a state of the model",
-        Refusal::NotConfigured => "it has no camera yet (Reset before Configure)",
+        Refusal::NotConfigured => "it has no camera yet (Reset or Hold before Configure)",
     }
 }
 

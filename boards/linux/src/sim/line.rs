@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 use digiteyes_core::protocol::{Decoder, HostMessage, MAX_MESSAGE};
 
 use super::corrupt::{Corruption, Noise, Position};
-use super::SimReport;
+use super::{Deafness, SimReport};
 use crate::serial::TtySerial;
 
 /// Most inbound bytes held back waiting for a delimiter; past this they go to the board as
@@ -43,6 +43,8 @@ pub(crate) struct Line {
     restart_after: Option<u32>,
     /// A power cycle is due: release nothing more until it is done.
     hold: bool,
+    /// Lose the host's bytes during these uploads.
+    deaf: Option<Deafness>,
     bytes_in: u64,
     bytes_out: u64,
     report: Arc<Mutex<SimReport>>,
@@ -53,6 +55,7 @@ impl Line {
         tty: TtySerial,
         corruption: Option<Corruption>,
         restart_after: Option<u32>,
+        deaf: Option<Deafness>,
         report: Arc<Mutex<SimReport>>,
     ) -> Self {
         let noise = corruption.map(|c| {
@@ -71,6 +74,7 @@ impl Line {
             frames_started: 0,
             restart_after,
             hold: false,
+            deaf,
             bytes_in: 0,
             bytes_out: 0,
             report,
@@ -138,6 +142,14 @@ impl Line {
                 self.frames_started += 1;
             }
             self.last_frame = Some(frame);
+        }
+        let deaf = self.deaf.is_some_and(|d| {
+            self.frames_started > d.after && self.frames_started <= d.after + d.frames
+        });
+        if deaf {
+            let n = message.len() as u64;
+            self.update_report(|r| r.deaf_in += n);
+            return;
         }
         let frame = chunk.or(self.last_frame);
         let mut hits = 0;

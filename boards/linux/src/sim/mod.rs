@@ -58,6 +58,19 @@ pub struct SimOptions {
     pub restart_after: Option<u32>,
     /// Where to hand every tracked frame, if anywhere.
     pub frame_tap: Option<FrameTap>,
+    /// Deaf for a while, as a board whose cable is pulled and plugged back: every byte from
+    /// the host is lost while the uploads of frames `after + 1 ..= after + frames` (counted
+    /// from 1) are under way; then the board hears again, with all it had before.
+    pub deaf: Option<Deafness>,
+}
+
+/// When a simulated board hears nothing ([`SimOptions::deaf`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Deafness {
+    /// Uploaded frames heard before the board goes deaf.
+    pub after: u32,
+    /// Uploaded frames it does not hear.
+    pub frames: u32,
 }
 
 impl Default for SimOptions {
@@ -67,6 +80,7 @@ impl Default for SimOptions {
             corruption: None,
             restart_after: None,
             frame_tap: None,
+            deaf: None,
         }
     }
 }
@@ -81,6 +95,12 @@ impl SimOptions {
     /// With one power cycle after `frames` uploaded frames.
     pub fn restart_after(mut self, frames: u32) -> Self {
         self.restart_after = Some(frames);
+        self
+    }
+
+    /// Deaf through the uploads of `frames` frames after `after` ([`SimOptions::deaf`]).
+    pub fn deaf(mut self, after: u32, frames: u32) -> Self {
+        self.deaf = Some(Deafness { after, frames });
         self
     }
 
@@ -112,6 +132,8 @@ pub struct SimReport {
     pub corrupted_out: u64,
     /// Sent bytes dropped because no host read them.
     pub discarded_out: u64,
+    /// Received bytes lost while the board was deaf ([`SimOptions::deaf`]).
+    pub deaf_in: u64,
     /// Serial errors the board loop returned (the loop goes on after each).
     pub serial_errors: u64,
     /// Tracked frames handed to the [`FrameTap`].
@@ -251,6 +273,7 @@ fn run(
         tty,
         options.corruption.clone(),
         options.restart_after,
+        options.deaf,
         report.clone(),
     )));
     let mut frame_buffer = vec![0u8; options.frame_buffer_bytes];
