@@ -107,7 +107,11 @@ fn a_held_frame_is_measured_as_the_in_process_search_finds_it() {
         .serial_mut()
         .send_frame(7, WIDTH as u16, HEIGHT as u16, &pixels);
     board.poll().unwrap();
-    assert_eq!(board.serial_mut().received(), [], "a held frame is not tracked");
+    assert_eq!(
+        board.serial_mut().received(),
+        [],
+        "a held frame is not tracked"
+    );
 
     let mut search = CameraSearch::new();
     for iteration in 0..3u8 {

@@ -26,6 +26,7 @@ use crate::mouse_pole::MouseConfig;
 use crate::report::{write_report, ReportOptions, ReportSummary};
 use crate::scenarios::{render_scenario, RenderOptions};
 use crate::sequence::{read_states, Sequence};
+use crate::stereo::{stream_stereo, StereoOptions, StereoSummary};
 use crate::stream::{stream_sequence, StreamOptions, StreamSummary};
 use crate::ui::{run_ui, UiOptions, UiSource, DEFAULT_BIND};
 use crate::TrackerConfig;
@@ -99,6 +100,75 @@ pub fn run_demo(
         board,
         eval,
         mouse,
+        report,
+    })
+}
+
+/// The scenario `demo --stereo` runs: the whole hand seen by two cameras.
+pub const STEREO_DEMO_SCENARIO: &str = "fullhand-stereo";
+
+/// Frames `demo --stereo` renders unless told otherwise.
+pub const STEREO_DEMO_FRAMES: usize = 120;
+
+/// What `demo --stereo` produced.
+#[derive(Debug, Clone)]
+pub struct StereoDemoResult {
+    /// The rendered sequence's folder, with `states.csv` and `report.html`.
+    pub sequence: PathBuf,
+    /// The run on the two boards (each board's figures included).
+    pub stream: StereoSummary,
+    /// Each simulated board's side of its line.
+    pub boards: Vec<SimReport>,
+    /// The evaluation of the states.
+    pub eval: EvalReport,
+    /// The HTML report of the run.
+    pub report: ReportSummary,
+}
+
+/// Renders [`STEREO_DEMO_SCENARIO`] into `dir` in `frames` frames and tracks it with one
+/// simulated board per camera, as the thesis' stereo system ran (`stream --port A --port
+/// B`): the host solves once per iteration with what both boards found. Evaluates the
+/// states (`dir/states.csv`) and writes `dir/report.html`.
+pub fn run_stereo_demo(
+    frames: usize,
+    dir: &Path,
+    config: TrackerConfig,
+    progress: bool,
+) -> Result<StereoDemoResult> {
+    let opts = RenderOptions {
+        frames: Some(frames),
+        progress,
+        ..RenderOptions::default()
+    };
+    render_scenario(STEREO_DEMO_SCENARIO, dir, &opts)?;
+    let n_cameras = Sequence::open(dir)?.cameras.len();
+    let boards = (0..n_cameras)
+        .map(|_| crate::sim::start(SimOptions::default()))
+        .collect::<Result<Vec<_>>>()?;
+    let ports = boards
+        .iter()
+        .map(|b| b.path().display().to_string())
+        .collect();
+    let states = dir.join("states.csv");
+    let mut options = StereoOptions::new(ports);
+    options.tracker = TrackerParams::from_config(&config);
+    options.progress = progress;
+    let stream = stream_stereo(dir, &states, &options)?;
+    let boards = boards
+        .into_iter()
+        .map(|b| b.stop().context("a simulated board failed"))
+        .collect::<Result<Vec<_>>>()?;
+    let eval = evaluate(dir, &states)?;
+    let report_options = ReportOptions {
+        thumb_every: frames.div_ceil(DEMO_THUMBNAILS).max(1),
+        ..ReportOptions::default()
+    };
+    let report = write_report(dir, &states, &dir.join(REPORT_HTML), &report_options)?;
+    Ok(StereoDemoResult {
+        sequence: dir.to_path_buf(),
+        stream,
+        boards,
+        eval,
         report,
     })
 }

@@ -10,8 +10,12 @@ use std::process::ExitCode;
 use anyhow::{bail, Result};
 use clap::{Args, Parser, Subcommand};
 use digiteyes_board_linux::SimOptions;
+use digiteyes_core::protocol::TrackerParams;
 use digiteyes_host::cli_values;
-use digiteyes_host::demo::{run_demo, serve_demo_ui, DEFAULT_DEMO_DIR, DEMO_FRAMES, REPORT_HTML};
+use digiteyes_host::demo::{
+    run_demo, run_stereo_demo, serve_demo_ui, DEFAULT_DEMO_DIR, DEMO_FRAMES, REPORT_HTML,
+    STEREO_DEMO_FRAMES,
+};
 use digiteyes_host::forward::one_euro::{self, Smoothing};
 use digiteyes_host::forward::parse_forward;
 use digiteyes_host::link::Link;
@@ -19,6 +23,7 @@ use digiteyes_host::listen::{listen, ListenOptions};
 use digiteyes_host::scenarios::{
     render_scenario, RenderOptions, DEFAULT_FRAMES, NAMES, RANDOM_NAMES,
 };
+use digiteyes_host::stereo::{stream_stereo, StereoOptions};
 use digiteyes_host::stream::{stream_camera, DEFAULT_BAUD};
 use digiteyes_host::ui::board_tap::ui_tap;
 use digiteyes_host::ui::{attach_mouse, run_ui, Hub, UiOptions, UiServer, UiSource, DEFAULT_BIND};
@@ -209,6 +214,16 @@ enum Command {
         /// frame N, announcing itself with a new Hello).
         #[arg(long, value_name = "N")]
         restart_after: Option<u32>,
+        /// Stand up this many boards (1 to 4), one per camera of a stereo sequence, each on
+        /// its own pseudo-terminal: `digiteyes stream --port A --port B --seq DIR`.
+        #[arg(long, value_name = "N", default_value_t = 1,
+              value_parser = clap::value_parser!(u8).range(1..=4))]
+        boards: u8,
+        /// The last board hears nothing while frames A..B are uploaded (frames A to B-1,
+        /// counted from 0), as if its cable were pulled, then hears again: to see a host
+        /// carry on without it and take it back.
+        #[arg(long, value_name = "A..B", value_parser = digiteyes_host::sim::parse_range)]
+        deaf_frames: Option<Range<u32>>,
         /// The board's frame buffer: the largest frame it accepts, WxH px.
         #[arg(long, value_name = "WxH", value_parser = parse_frame_size, default_value = "640x480")]
         max_frame: (u32, u32),
@@ -237,10 +252,19 @@ enum Command {
     /// superseded, tracker error, no reply (timeout), board restarted) — its row repeats the
     /// last state with lost = 1. Prints a summary and the link's figures (states/s, bytes,
     /// CRC/framing errors on both ends, the board's drops by reason). A board tracks one
-    /// camera: a stereo sequence needs --camera-index.
+    /// camera: a stereo sequence needs --camera-index, or one board per camera.
+    ///
+    /// One board per camera (--port given once per camera of --seq, in camera order), as the
+    /// thesis' stereo system ran: each board holds its camera's frames (Hold); per
+    /// Gauss–Newton iteration the host sends the state to every board (Measure), each
+    /// searches its own frame at it and answers with the edges and tips it found, and the
+    /// host solves once with all of them — the same states as `track` on the sequence with
+    /// the same --iterations. A board that does not answer within --reply-timeout is left
+    /// out (the other cameras carry on, and the summary says so) and taken back as soon as
+    /// it answers again. docs/link.md has the bytes per iteration and the rates they allow.
     Stream {
         #[command(flatten)]
-        port: PortArgs,
+        port: StreamPorts,
         /// Sequence folder whose frames to upload.
         #[arg(
             long,
@@ -263,6 +287,10 @@ enum Command {
         /// The camera of a multi-camera sequence to track (0-based).
         #[arg(long, value_name = "N")]
         camera_index: Option<usize>,
+        /// Gauss–Newton iterations per frame, 1 to 50 (default: the tracker's, 8; the thesis
+        /// ran one per frame).
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(1..=50))]
+        iterations: Option<u8>,
         /// Output CSV path (default: states.csv in the current folder).
         #[arg(long, short, default_value = "states.csv", hide_default_value = true)]
         out: PathBuf,
@@ -394,10 +422,19 @@ enum Command {
     /// and the UI. In a terminal it then serves the UI (a replay of the run: 3D hand, camera
     /// overlay, 3D mouse, link figures) until Ctrl-C; otherwise it prints the
     /// `digiteyes ui --replay` command that shows it.
+    ///
+    /// With --stereo: the whole hand (`fullhand-stereo`) from two cameras, each camera's
+    /// frames on its own simulated board, the host solving once per iteration with what both
+    /// found (as `stream --port A --port B` does).
     Demo {
-        /// Number of frames (500: the thesis' pace; fewer play the same trial faster).
-        #[arg(long, default_value_t = DEMO_FRAMES, value_parser = cli_values::frame_count)]
-        frames: usize,
+        /// Number of frames (default 500, the thesis' pace: fewer play the same trial faster;
+        /// with --stereo, default 120).
+        #[arg(long, value_parser = cli_values::frame_count)]
+        frames: Option<usize>,
+        /// Track the whole hand from two cameras instead, one simulated board per camera as
+        /// the thesis' stereo system ran (`stream --port A --port B`).
+        #[arg(long)]
+        stereo: bool,
         /// Folder for the run: the sequence, states.csv and report.html (created if
         /// missing; its files are overwritten).
         #[arg(long, visible_alias = "keep", value_name = "DIR", default_value = DEFAULT_DEMO_DIR)]
@@ -436,6 +473,26 @@ struct PortArgs {
     /// Seconds to wait for each answer of the board (a frame's State or Dropped, an Ack).
     /// Without a frame's answer by then, a Ping probes for as long again (a slow answer still
     /// counts); then the frame counts as dropped, "no reply (timeout)". At most a week.
+    #[arg(long, value_name = "S", default_value_t = 2.0, value_parser = cli_values::positive_seconds)]
+    reply_timeout: f64,
+}
+
+/// The boards `stream` talks to: one, or one per camera.
+#[derive(Args, Debug)]
+struct StreamPorts {
+    /// A board's serial device: a UART or USB serial adapter (/dev/ttyUSB0), or a
+    /// pseudo-terminal `digiteyes sim` printed (/dev/pts/N). Give it once per camera of a
+    /// stereo --seq (in camera order) for one board per camera.
+    #[arg(long, value_name = "TTY", required = true, num_args = 1)]
+    port: Vec<String>,
+    /// Line speed in bits/s (8N1; ignored by pseudo-terminals).
+    #[arg(long, value_name = "B", default_value_t = DEFAULT_BAUD)]
+    baud: u32,
+    /// Seconds to wait for each answer of a board (a frame's State or Dropped, an Ack, the
+    /// answer to a Measure). Without a frame's answer by then, a Ping probes for as long
+    /// again (a slow answer still counts); then the frame counts as dropped, "no reply
+    /// (timeout)". With one board per camera, a board that does not answer a Measure in time
+    /// is left out until it answers again. At most a week.
     #[arg(long, value_name = "S", default_value_t = 2.0, value_parser = cli_values::positive_seconds)]
     reply_timeout: f64,
 }
@@ -535,6 +592,8 @@ fn run(cli: Cli) -> Result<()> {
             corrupt_frames,
             seed,
             restart_after,
+            boards,
+            deaf_frames,
             max_frame,
             report_every,
             overlay,
@@ -577,14 +636,30 @@ fn run(cli: Cli) -> Result<()> {
                 }
                 None => None,
             };
-            let board = digiteyes_host::sim::start(options)?;
-            println!("simulated board on {}", board.path().display());
+            if boards > 1 && (overlay.is_some() || ui.is_some()) {
+                bail!("--overlay and --ui watch one board: leave them out with --boards {boards}");
+            }
+            let mut started = Vec::new();
+            for b in 0..boards {
+                let mut options = options.clone();
+                if let (Some(deaf), true) = (&deaf_frames, b + 1 == boards) {
+                    options = options.deaf(deaf.start, deaf.end.saturating_sub(deaf.start));
+                }
+                let board = digiteyes_host::sim::start(options)?;
+                println!("simulated board on {}", board.path().display());
+                started.push(board);
+            }
+            let ports: Vec<String> = started
+                .iter()
+                .map(|b| format!("--port {}", b.path().display()))
+                .collect();
             println!(
-                "connect with: digiteyes stream --port {} --seq DIR   (Ctrl-C stops the board)",
-                board.path().display()
+                "connect with: digiteyes stream {} --seq DIR   (Ctrl-C stops the board{})",
+                ports.join(" "),
+                if boards > 1 { "s" } else { "" }
             );
             let every = (report_every > 0.0).then(|| cli_values::duration(report_every));
-            digiteyes_host::sim::serve(board, every)?;
+            digiteyes_host::sim::serve(started, every)?;
         }
         Command::Stream {
             port,
@@ -593,15 +668,40 @@ fn run(cli: Cli) -> Result<()> {
             setup,
             frames,
             camera_index,
+            iterations,
             out,
             quiet,
         } => {
-            let mut options = StreamOptions::new(&port.port)
+            let tracker = TrackerParams::from_config(&tracker_config(iterations, false));
+            if port.port.len() > 1 {
+                let Some(seq) = seq else {
+                    bail!(
+                        "one board per camera (--port given {} times) needs --seq DIR: a                          sequence with that many cameras",
+                        port.port.len()
+                    );
+                };
+                if camera_index.is_some() {
+                    bail!("--camera-index picks the one camera of a single board; with one --port per camera leave it out");
+                }
+                let mut options = StereoOptions::new(port.port);
+                options.baud = port.baud;
+                options.reply_timeout = cli_values::duration(port.reply_timeout);
+                options.tracker = tracker;
+                options.progress = progress && !quiet;
+                let summary = stream_stereo(&seq, &out, &options)?;
+                print!("{summary}");
+                if summary.frames == summary.lost_frames {
+                    bail!("every frame was lost: no board measured the hand");
+                }
+                return Ok(());
+            }
+            let port_path = port.port.first().cloned().unwrap_or_default();
+            let mut options = StreamOptions::new(&port_path)
                 .baud(port.baud)
                 .reply_timeout(cli_values::duration(port.reply_timeout))
                 .camera_index(camera_index)
                 .progress(progress && !quiet);
-            options.tracker = Default::default();
+            options.tracker = tracker;
             let summary = match (seq, camera, setup) {
                 (Some(seq), None, _) => stream_sequence(&seq, &out, &options)?,
                 (None, Some(camera), Some(setup)) => {
@@ -693,15 +793,29 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Demo {
             frames,
+            stereo,
             out,
             ui_seconds,
         } => {
-            let result = run_demo(frames, &out, TrackerConfig::default(), progress)?;
-            println!("{}", result.stream);
-            println!("{}", result.board);
-            print!("{}", result.eval);
-            println!("{}", result.mouse);
-            let dir = std::path::absolute(&result.sequence).unwrap_or(result.sequence);
+            let sequence = if stereo {
+                let frames = frames.unwrap_or(STEREO_DEMO_FRAMES);
+                let result = run_stereo_demo(frames, &out, TrackerConfig::default(), progress)?;
+                print!("{}", result.stream);
+                for (i, board) in result.boards.iter().enumerate() {
+                    println!("camera {i}'s {board}");
+                }
+                print!("{}", result.eval);
+                result.sequence
+            } else {
+                let frames = frames.unwrap_or(DEMO_FRAMES);
+                let result = run_demo(frames, &out, TrackerConfig::default(), progress)?;
+                println!("{}", result.stream);
+                println!("{}", result.board);
+                print!("{}", result.eval);
+                println!("{}", result.mouse);
+                result.sequence
+            };
+            let dir = std::path::absolute(&sequence).unwrap_or(sequence);
             println!("run kept in {}", dir.display());
             println!();
             println!("report: {}", dir.join(REPORT_HTML).display());

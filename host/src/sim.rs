@@ -52,23 +52,30 @@ pub fn start(options: SimOptions) -> Result<SimBoard> {
     SimBoard::start(options).context("cannot start the simulated board on a pseudo-terminal")
 }
 
-/// Runs `board` until the process is interrupted, printing its line's figures every
-/// `every` (never when `None`).
-pub fn serve(board: SimBoard, every: Option<Duration>) -> Result<()> {
-    match every {
-        None => {
-            board.wait().context("the simulated board stopped")?;
+/// Runs `boards` until the process is interrupted (or one stops), printing each line's
+/// figures every `every` (never when `None`).
+pub fn serve(boards: Vec<SimBoard>, every: Option<Duration>) -> Result<()> {
+    // How often a quiet server looks whether every board still runs.
+    const CHECK: Duration = Duration::from_millis(200);
+    let mut since_report = Duration::ZERO;
+    loop {
+        std::thread::sleep(CHECK);
+        if let Some(stopped) = boards.iter().position(|b| !b.is_running()) {
+            let mut boards = boards;
+            boards
+                .swap_remove(stopped)
+                .wait()
+                .context("a simulated board stopped")?;
+            return Ok(());
         }
-        Some(every) => loop {
-            std::thread::sleep(every);
-            if !board.is_running() {
-                board.wait().context("the simulated board stopped")?;
-                break;
+        since_report += CHECK;
+        if every.is_some_and(|e| since_report >= e) {
+            since_report = Duration::ZERO;
+            for b in &boards {
+                eprintln!("{}: {}", b.path().display(), b.report());
             }
-            eprintln!("{}", board.report());
-        },
+        }
     }
-    Ok(())
 }
 
 /// What an [`OverlayWriter`] did.

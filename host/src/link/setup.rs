@@ -50,7 +50,8 @@ impl SessionSetup {
             None if n_cameras == 1 => 0,
             None => bail!(
                 "{}: the sequence has {n_cameras} cameras; a board tracks one camera (as the \
-                 IC40 ran one board per camera): pick one with --camera-index 0..{}",
+                 IC40 ran one board per camera): pick one with --camera-index 0..{}, or give \
+                 one --port per camera",
                 sequence.dir.display(),
                 n_cameras - 1
             ),
