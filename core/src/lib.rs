@@ -17,6 +17,7 @@
 //! - [`estimator`]: residuals, row-by-row normal equations, conditioned Gauss–Newton (Eq. 2.22).
 //! - [`motion`]: the prediction between frames, the prior toward it, what a lost frame keeps.
 //! - [`silhouette`]: how well the projected silhouette agrees with the image (region evidence).
+//! - [`likelihood`]: how well a hypothesised state explains a frame (oriented chamfer + silhouette).
 //! - [`search`]: one camera's slice search across a frame's iterations (coarse to fine).
 //! - [`measurer`]: where the loop's features come from: local frames, or one board per camera.
 //! - [`remote`]: a board's answer to a stereo host's `Measure`, and its features on the wire.
@@ -37,6 +38,7 @@ pub mod estimator;
 pub mod features;
 pub mod frame;
 pub mod kinematics;
+pub mod likelihood;
 pub mod measurement;
 pub mod measurer;
 pub mod model;

@@ -1,0 +1,137 @@
+//! The image likelihood (issue 10) orders hypotheses: on frames from our renderer, on rigs
+//! nobody tuned for (random-mono seeds 201..=215; the parameters were chosen on 101..=105),
+//! the true state scores better than the same state perturbed — always for a palm moved
+//! 30 mm or turned 40°, in at least 39 of 40 cases for smaller perturbations — and a frame
+//! without the hand scores the true state poorly.
+
+use std::path::Path;
+
+use digiteyes_core::frame::FrameView;
+use digiteyes_core::kinematics::Poses;
+use digiteyes_core::likelihood::{evaluate, EdgeMap, Likelihood, LikelihoodConfig};
+use digiteyes_core::projection::ProjectedModel;
+use digiteyes_host::sequence::Sequence;
+use digiteyes_host::{render_scenario, RenderOptions};
+
+fn render(dir: &Path, scenario: &str, seed: u64, frames: usize) -> Sequence {
+    let seq = dir.join(format!("{scenario}-{seed}"));
+    let options = RenderOptions {
+        frames: Some(frames),
+        size: Some((320, 240)),
+        seed,
+        ..RenderOptions::default()
+    };
+    render_scenario(scenario, &seq, &options).unwrap();
+    Sequence::open(&seq).unwrap()
+}
+
+fn score(sequence: &Sequence, k: usize, q: &[f32], blank: bool) -> Likelihood {
+    let config = LikelihoodConfig::default();
+    let mut image = sequence.read_frame(0, k).unwrap();
+    if blank {
+        // The background alone: the first pixel's grey everywhere.
+        let grey = image.as_raw()[0];
+        image.as_mut().fill(grey);
+    }
+    let frame = FrameView::packed(
+        image.as_raw(),
+        image.width() as usize,
+        image.height() as usize,
+    )
+    .unwrap();
+    let mut buffer =
+        vec![0u8; EdgeMap::bytes_needed(frame.width(), frame.height(), config.stride_px)];
+    let edges = EdgeMap::build(&mut buffer, &frame, &config).unwrap();
+    let camera = &sequence.cameras[0];
+    let poses = Poses::compute(&sequence.model, q).unwrap();
+    let mut view = ProjectedModel::new();
+    view.update(&sequence.model, &poses, camera, 4.0);
+    evaluate(&view, camera, &frame, &edges, &config)
+}
+
+/// `q` with the palm moved `dx` mm along x, turned `angle` rad about its z axis, and every
+/// finger joint flexed by `bend` rad.
+fn perturbed(q: &[f32], dx: f32, angle: f32, bend: f32) -> Vec<f32> {
+    let mut p = q.to_vec();
+    p[4] += dx;
+    let (c, s) = ((angle / 2.0).cos(), (angle / 2.0).sin());
+    let (w, x, y, z) = (q[0], q[1], q[2], q[3]);
+    // q ⊗ (c, 0, 0, s)
+    p[0] = w * c - z * s;
+    p[1] = x * c + y * s;
+    p[2] = y * c - x * s;
+    p[3] = z * c + w * s;
+    for v in p.iter_mut().skip(7) {
+        *v += bend;
+    }
+    p
+}
+
+#[test]
+fn the_true_state_scores_better_than_perturbed_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut worse = 0;
+    let mut cases = 0;
+    let mut margins = Vec::new();
+    let randoms = (0..8).map(|i| ("random-mono", 201 + 2 * i));
+    for (scenario, seed) in [("fullhand-mono", 1)].into_iter().chain(randoms) {
+        let sequence = render(dir.path(), scenario, seed, 20);
+        let truth = sequence.read_truth().unwrap();
+        for k in [0, 10, 19] {
+            let q: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
+            let at_truth = score(&sequence, k, &q, false);
+            assert!(
+                at_truth.score > 0.5,
+                "{scenario} {seed} frame {k}: {at_truth:?}"
+            );
+            for (dx, angle, bend) in [
+                (15.0, 0.0, 0.0),
+                (-30.0, 0.0, 0.0),
+                (0.0, 0.35, 0.0),
+                (0.0, -0.7, 0.0),
+                (0.0, 0.0, 0.4),
+                (10.0, 0.2, -0.3),
+            ] {
+                let other = score(&sequence, k, &perturbed(&q, dx, angle, bend), false);
+                cases += 1;
+                margins.push(at_truth.score - other.score);
+                let large = dx.abs() >= 30.0 || angle.abs() >= 0.7;
+                assert!(
+                    !large || other.score < at_truth.score,
+                    "{scenario} {seed} frame {k}: a large perturbation ({dx} mm, {angle} rad) \
+                     scores {:.3} >= the truth's {:.3}",
+                    other.score,
+                    at_truth.score
+                );
+                if other.score >= at_truth.score {
+                    worse += 1;
+                    println!(
+                        "{scenario} {seed} frame {k}: ({dx}, {angle}, {bend}) scores {:.3} >= truth {:.3} ({other:?} vs {at_truth:?})",
+                        other.score, at_truth.score
+                    );
+                }
+            }
+            let blank = score(&sequence, k, &q, true);
+            assert!(
+                blank.score < at_truth.score - 0.3,
+                "{scenario} {seed} frame {k}: no hand {:.3}, hand {:.3}",
+                blank.score,
+                at_truth.score
+            );
+        }
+    }
+    margins.sort_by(f32::total_cmp);
+    println!(
+        "{cases} perturbations: truth better in {}; margin min {:.3}, median {:.3}",
+        cases - worse,
+        margins[0],
+        margins[margins.len() / 2]
+    );
+    // Small perturbations of curled fingers can hide as much of the silhouette as the truth
+    // does: measured on these seeds, 1 in 162 ties within 0.003 (docs/recovery.md).
+    assert!(
+        worse * 40 <= cases,
+        "the truth scored best in only {} of {cases}",
+        cases - worse
+    );
+}
