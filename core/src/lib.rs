@@ -18,6 +18,7 @@
 //! - [`motion`]: the prediction between frames, the prior toward it, what a lost frame keeps.
 //! - [`silhouette`]: how well the projected silhouette agrees with the image (region evidence).
 //! - [`likelihood`]: how well a hypothesised state explains a frame (oriented chamfer + silhouette).
+//! - [`acquire`]: the anytime coarse-to-fine search that finds the hand without help.
 //! - [`search`]: one camera's slice search across a frame's iterations (coarse to fine).
 //! - [`measurer`]: where the loop's features come from: local frames, or one board per camera.
 //! - [`remote`]: a board's answer to a stereo host's `Measure`, and its features on the wire.
@@ -32,6 +33,7 @@
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod acquire;
 pub mod camera;
 pub mod config;
 pub mod estimator;

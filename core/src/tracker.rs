@@ -257,6 +257,15 @@ impl Tracker {
         Ok(())
     }
 
+    /// Restarts from `state` as [`Tracker::reset`] does, and also forgets the silhouette
+    /// reference, so the next frame sets it afresh: for a state found by a search, which may
+    /// be refused, so that a refused guess leaves nothing behind.
+    pub fn restart_fresh(&mut self, state: &[f32]) -> Result<(), TrackerError> {
+        self.reset(state)?;
+        self.silhouette_reference = None;
+        Ok(())
+    }
+
     /// The current state estimate (quaternion, mm, rad).
     pub fn state(&self) -> &[f32] {
         &self.state

@@ -30,6 +30,7 @@
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod acquire;
 pub mod atomic_file;
 pub mod bench;
 pub mod cli_values;
