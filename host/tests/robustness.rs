@@ -93,10 +93,32 @@ fn the_benchmark_runs_a_tiny_sweep() {
         motion: Motion::Plain,
         json: Some(dir.path().join("sweep.json")),
         keep: None,
+        gallery: Some(dir.path().join("gallery")),
     };
     let sweep = run(&args).unwrap();
     assert!(sweep.failed.is_empty(), "{:?}", sweep.failed);
     assert_eq!(sweep.seeds.len(), 2);
+    // The gallery holds each camera's frame where a seed was first truly lost, and only those.
+    let mut expected: Vec<String> = sweep
+        .seeds
+        .iter()
+        .filter_map(|s| s.first_truly_lost.map(|k| (s, k)))
+        .flat_map(|(s, k)| {
+            let cameras = if s.stereo { 2 } else { 1 };
+            (0..cameras).map(move |c| format!("seed{:04}-frame{k:04}-cam{c}.png", s.seed))
+        })
+        .collect();
+    let mut written: Vec<String> = std::fs::read_dir(dir.path().join("gallery"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    expected.sort();
+    written.sort();
+    assert_eq!(written, expected);
+    for name in &written {
+        let image = image::open(dir.path().join("gallery").join(name)).unwrap();
+        assert_eq!((image.width(), image.height()), (160, 120), "{name}");
+    }
     for s in &sweep.seeds {
         assert_eq!(s.stereo, s.seed.is_multiple_of(2));
         assert_eq!(s.frames, 10);
@@ -131,6 +153,7 @@ fn a_small_sweep_holds_the_hand_better_than_the_plain_loop() {
             motion,
             json: None,
             keep: None,
+            gallery: None,
         })
         .unwrap()
     };

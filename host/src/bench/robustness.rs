@@ -79,6 +79,11 @@ pub struct RobustnessArgs {
     /// Keep the rendered sequences and states here (default: a temporary folder).
     #[arg(long, value_name = "DIR")]
     pub keep: Option<PathBuf>,
+    /// Write a gallery of the failures here: for every seed that is truly lost, each
+    /// camera's frame where that first happens, with the tracked model drawn over it
+    /// (DIR/seedNNNN-frameNNNN-camN.png, the colours of docs/overlay.md).
+    #[arg(long, value_name = "DIR")]
+    pub gallery: Option<PathBuf>,
 }
 
 /// One seed's figures.
@@ -196,11 +201,32 @@ pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResu
             result.far_unflagged += 1;
         }
     }
+    if let (Some(gallery), Some(k)) = (&args.gallery, result.first_truly_lost) {
+        let state: Vec<f32> = table.table.rows[k].iter().map(|&v| v as f32).collect();
+        for (c, camera) in sequence.cameras.iter().enumerate() {
+            let frame = sequence.read_frame(c, k)?;
+            let drawn = crate::overlay::draw_overlay(
+                &sequence.model,
+                camera,
+                &state,
+                &frame,
+                &args.motion.config().features,
+            )?;
+            let path = gallery.join(format!("seed{seed:04}-frame{k:04}-cam{c}.png"));
+            drawn
+                .save(&path)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+    }
     Ok(result)
 }
 
 /// Runs the sweep on `args.jobs` threads; seeds that could not be rendered are listed apart.
 pub fn run(args: &RobustnessArgs) -> Result<Sweep> {
+    if let Some(gallery) = &args.gallery {
+        std::fs::create_dir_all(gallery)
+            .with_context(|| format!("cannot create {}", gallery.display()))?;
+    }
     let temp;
     let dir = match &args.keep {
         Some(dir) => {
