@@ -258,3 +258,83 @@ fn the_emulated_m7_board_tracks_a_mouse_sequence_as_well_as_the_host() {
         started.elapsed().as_secs_f64()
     );
 }
+
+/// Two emulated boards, one hand (issue 13): each holds one camera's frames and searches them
+/// at the host's state; the host solves once per iteration. The states must be the
+/// in-process stereo tracker's on the same frames (to 1e-4; printed: how many bit-equal).
+#[test]
+fn two_emulated_m7_boards_track_a_stereo_sequence_as_the_host_does() {
+    let started = Instant::now();
+    let elf = match prerequisites() {
+        Ok(elf) => elf,
+        Err(reason) => {
+            common::skip(
+                "two emulated Cortex-M7 boards, one stereo hand (tests/tests/qemu_board.rs)",
+                &reason,
+            );
+            return;
+        }
+    };
+    const STEREO_FRAMES: usize = 4;
+    const ITERATIONS: u8 = 2;
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("stereo");
+    let render = RenderOptions {
+        frames: Some(STEREO_FRAMES),
+        size: Some(SIZE),
+        supersample: 2,
+        ..RenderOptions::default()
+    };
+    render_scenario("fullhand-stereo", &seq, &render).unwrap();
+    let (dir0, dir1) = (dir.path().join("board0"), dir.path().join("board1"));
+    std::fs::create_dir_all(&dir0).unwrap();
+    std::fs::create_dir_all(&dir1).unwrap();
+    let (port0, board0) = boot_board(&dir0, &elf);
+    let (port1, board1) = boot_board(&dir1, &elf);
+    let mut config = TrackerConfig::default();
+    config.iterations = ITERATIONS;
+    let config = digiteyes_host::stereo::wire_config(&config).unwrap();
+    let mut options = digiteyes_host::stereo::StereoOptions::new(vec![
+        port0.display().to_string(),
+        port1.display().to_string(),
+    ]);
+    options.tracker = digiteyes_core::protocol::TrackerParams::from_config(&config);
+    // A frame's upload takes ~1 s on QEMU's UART; 15 s is a hang, not a slow board.
+    options.reply_timeout = Duration::from_secs(15);
+    let csv = dir.path().join("boards.csv");
+    let summary = digiteyes_host::stereo::stream_stereo(&seq, &csv, &options).unwrap();
+    drop((board0, board1));
+    print!("{summary}");
+    assert_eq!(summary.frames, STEREO_FRAMES);
+    for b in &summary.boards {
+        assert_eq!((b.unanswered, b.frames_without), (0, 0), "{b:?}");
+    }
+
+    let sequence = Sequence::open(&seq).unwrap();
+    let mut tracker = sequence_tracker(&sequence, config).unwrap();
+    let got = digiteyes_host::sequence::read_states(&csv, sequence.n_states()).unwrap();
+    let (mut worst, mut equal) = (0.0f64, 0);
+    for (k, row) in got.rows.iter().enumerate() {
+        let images: Vec<_> = (0..2).map(|c| sequence.read_frame(c, k).unwrap()).collect();
+        let views: Vec<_> = images
+            .iter()
+            .map(|i| {
+                FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize).unwrap()
+            })
+            .collect();
+        tracker.track(&views).unwrap();
+        let mut same = true;
+        for (x, y) in row.iter().zip(tracker.state()) {
+            let d = (x - f64::from(*y)).abs();
+            worst = worst.max(d);
+            same &= d == 0.0;
+        }
+        equal += usize::from(same);
+    }
+    println!(
+        "two emulated boards vs in-process stereo: largest difference {worst:e}, {equal} of \
+         {STEREO_FRAMES} frames equal as written; test took {:.1} s",
+        started.elapsed().as_secs_f64()
+    );
+    assert!(worst <= 1e-4, "largest difference {worst:e}");
+}
