@@ -18,6 +18,9 @@ use crate::projection::Bounds;
 use crate::projection::ProjectedModel;
 use crate::visibility::{candidates, cover_among, Cover};
 
+mod axis_line;
+pub use axis_line::fit_axis_line;
+
 /// Which sign of intensity change, going outward across an edge, counts as an edge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

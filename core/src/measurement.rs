@@ -8,7 +8,7 @@ use heapless::Vec;
 
 use crate::camera::Camera;
 use crate::config::MAX_FRAMES;
-use crate::estimator::fit_axis_line;
+use crate::features::fit_axis_line;
 use crate::features::{find_link_features, FeatureConfig, LinkFeatures};
 use crate::frame::FrameView;
 use crate::kinematics::Poses;
