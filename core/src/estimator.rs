@@ -25,7 +25,8 @@
 use nalgebra::SVector;
 
 use crate::config::MAX_STATES;
-use crate::model::{Model, BASE_STATES};
+use crate::model::Model;
+use crate::state::{clamp_to_limit, renormalise_quaternion, StateKind};
 
 mod config;
 mod jacobian;
@@ -52,21 +53,15 @@ pub fn apply_step(
             continue;
         }
         *v += delta[i];
-        if i >= BASE_STATES {
-            if let Some(limit) = model.limit(i) {
-                *v = v.clamp(limit.lo, limit.hi);
+        match StateKind::of(i) {
+            StateKind::Joint => {
+                *v = clamp_to_limit(model, i, *v);
+                max_angle = max_angle.max(delta[i].abs());
             }
-            max_angle = max_angle.max(delta[i].abs());
-        } else if i >= 4 {
-            max_move = max_move.max(delta[i].abs());
-        } else {
-            max_angle = max_angle.max(delta[i].abs());
+            StateKind::Translation => max_move = max_move.max(delta[i].abs()),
+            StateKind::Quaternion => max_angle = max_angle.max(delta[i].abs()),
         }
     }
-    if q.len() >= 4 {
-        if let Some(u) = crate::quaternion::normalised([q[0], q[1], q[2], q[3]]) {
-            q[..4].copy_from_slice(&u);
-        }
-    }
+    renormalise_quaternion(q);
     (max_angle, max_move)
 }

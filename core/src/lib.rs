@@ -16,6 +16,7 @@
 //! - [`features`]: the slice edge search of Sec. 4.3.1 with occlusion masking.
 //! - [`estimator`]: residuals gathered per link into the normal equations, conditioned
 //!   Gauss–Newton solved by `LDLᵀ` (Eq. 2.22); [`estimator::reference`] is the oracle.
+//! - [`state`]: the state vector's layout (palm quaternion, translation, joints).
 //! - [`motion`]: the prediction between frames, the prior toward it, what a lost frame keeps.
 //! - [`silhouette`]: how well the projected silhouette agrees with the image (region evidence).
 //! - [`tracker`]: the per-frame loop and its report.
@@ -43,6 +44,7 @@ pub mod projection;
 pub mod protocol;
 pub mod quaternion;
 pub mod silhouette;
+pub mod state;
 pub mod tracker;
 pub mod visibility;
 

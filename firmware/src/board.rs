@@ -3,6 +3,7 @@
 use core::convert::Infallible;
 
 use digiteyes_core::camera::Camera;
+use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::measurement::measure_links;
 use digiteyes_core::model::Model;
@@ -294,14 +295,13 @@ where
         if q.len() != model.n_states() || q.iter().any(|v| !v.is_finite()) {
             return Err(Refusal::BadState);
         }
-        if model.n_states() < 32 && free >> model.n_states() != 0 {
-            return Err(Refusal::BadFreeMask);
-        }
-        let list: Vec<u8, 32> = (0..32u8).filter(|&i| free & (1 << i) != 0).collect();
-        Tracker::new(model, &[*camera], q, Some(&list), config).map_err(|e| match e {
+        Tracker::new(model, &[*camera], q, FreeMask(free), config).map_err(|e| match e {
             TrackerError::BadFreeState(_) => Refusal::BadFreeMask,
             TrackerError::Camera(_) | TrackerError::CameraCount => Refusal::BadCamera,
-            _ => Refusal::BadState,
+            TrackerError::State(_) => Refusal::BadState,
+            // Not returned by `Tracker::new` (they are about frames given to `track`); a
+            // state the tracker cannot start from is the nearest refusal.
+            TrackerError::FrameCount | TrackerError::Frame(_) => Refusal::BadState,
         })
     }
 

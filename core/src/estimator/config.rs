@@ -1,5 +1,7 @@
 //! The estimator's parameters: residual kind, robust weight, conditioning, free states.
 
+use crate::state::{StateKind, QUATERNION_BITS};
+
 /// Which residuals a link's edge points give.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -28,6 +30,7 @@ pub enum Robust {
 
 impl Robust {
     /// The weight of a residual `r` (px).
+    #[inline]
     pub fn weight(&self, r: f32) -> f32 {
         let a = r.abs();
         match *self {
@@ -64,11 +67,12 @@ impl Conditioning {
     };
 
     /// `S` for state `i`.
+    #[inline]
     pub fn for_state(&self, i: usize) -> f32 {
-        match i {
-            0..=3 => self.quaternion,
-            4..=6 => self.translation,
-            _ => self.joint,
+        match StateKind::of(i) {
+            StateKind::Quaternion => self.quaternion,
+            StateKind::Translation => self.translation,
+            StateKind::Joint => self.joint,
         }
     }
 }
@@ -114,7 +118,35 @@ impl FreeMask {
         FreeMask(if n >= 32 { u32::MAX } else { (1u32 << n) - 1 })
     }
 
+    /// The states listed, or the first listed that no mask can hold (32 or more).
+    pub fn from_states(states: &[u8]) -> Result<Self, u8> {
+        let mut mask = 0u32;
+        for &s in states {
+            mask |= 1u32.checked_shl(u32::from(s)).ok_or(s)?;
+        }
+        Ok(FreeMask(mask))
+    }
+
+    /// The same states with the whole quaternion free if any of its components is: its four
+    /// components move together (a step renormalises them).
+    #[inline]
+    pub fn with_whole_quaternion(self) -> Self {
+        if self.0 & QUATERNION_BITS != 0 {
+            FreeMask(self.0 | QUATERNION_BITS)
+        } else {
+            self
+        }
+    }
+
+    /// The first state named that a model with `n` states does not have, if any.
+    #[inline]
+    pub fn first_beyond(&self, n: usize) -> Option<u8> {
+        let beyond = if n >= 32 { 0 } else { self.0 >> n };
+        (beyond != 0).then(|| (n as u32 + beyond.trailing_zeros()) as u8)
+    }
+
     /// Whether state `i` is free.
+    #[inline]
     pub fn contains(&self, i: usize) -> bool {
         i < 32 && self.0 & (1 << i) != 0
     }

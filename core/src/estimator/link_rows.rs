@@ -6,7 +6,7 @@ use nalgebra::Vector2;
 use super::normal::{packed, position};
 use super::{EstimatorConfig, FreeMask, LinkJacobian, NormalEquations, ResidualKind};
 use crate::config::{MAX_ROW_NONZEROS, MAX_STATES};
-use crate::features::{axis_frame, fit_axis_line, EdgePoint, LinkFeatures};
+use crate::features::{fit_axis_line, EdgePoint, LinkFeatures};
 use crate::projection::ProjectedLink;
 
 /// What one link contributed to the normal equations.
@@ -151,7 +151,7 @@ struct EdgeBasis {
 
 impl EdgeBasis {
     fn new(link: &ProjectedLink) -> Self {
-        let (_, normal) = axis_frame(&link.a, &link.b);
+        let normal = link.normal();
         let axis = link.b - link.a;
         EdgeBasis {
             normal,
@@ -262,7 +262,7 @@ pub fn add_link_rows(
     }
     if let Some(tip) = features.tip {
         // Eq. 2.19, as `tip_row`: `dir·∂b + ∂r1`.
-        let (dir, _) = axis_frame(&link.a, &link.b);
+        let (dir, _) = link.axis_frame();
         let r = dir.dot(&(link.b - tip)) + link.tip_offset;
         let c = [0.0, 0.0, dir.x, dir.y, 0.0, 1.0];
         block.add(&c, r, config.tip_weight * config.robust.weight(r));

@@ -10,11 +10,13 @@ use crate::model::BASE_STATES;
 /// Where state `s` is stored in [`NormalEquations`]: the joints (`q7`...) first, the palm
 /// states last. Every row involves the palm and one joint chain, so in this order `JᵀWJ` is
 /// block-arrowhead and its factor has no fill outside the rows' envelope.
+#[inline]
 pub(super) fn position(s: usize) -> usize {
     (s + MAX_STATES - BASE_STATES) % MAX_STATES
 }
 
 /// The state stored at position `p` (the inverse of [`position`]).
+#[inline]
 fn state_at(p: usize) -> usize {
     (p + BASE_STATES) % MAX_STATES
 }
@@ -23,6 +25,7 @@ fn state_at(p: usize) -> usize {
 const LOWER: usize = MAX_STATES * (MAX_STATES - 1) / 2;
 
 /// Index in a packed strict lower triangle of element (`hi`, `lo`), `hi > lo`.
+#[inline]
 pub(super) fn packed(hi: usize, lo: usize) -> usize {
     hi * (hi - 1) / 2 + lo
 }

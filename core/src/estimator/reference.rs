@@ -17,7 +17,7 @@ use nalgebra::Vector2;
 
 use super::{EstimatorConfig, FreeMask, LinkJacobian, LinkRows, NormalEquations, ResidualKind};
 use crate::config::MAX_ROW_NONZEROS;
-use crate::features::{axis_frame, fit_axis_line, EdgePoint, LinkFeatures};
+use crate::features::{fit_axis_line, EdgePoint, LinkFeatures};
 use crate::projection::ProjectedLink;
 
 /// A row of derivative entries `(state, ∂r/∂q_state)`.
@@ -26,7 +26,7 @@ pub type Row = Vec<(u8, f32), MAX_ROW_NONZEROS>;
 /// The edge-point residual of `edge` (px): the predicted silhouette offset minus the measured
 /// one, at the edge's foot on the axis. Positive when the edge lies inside the prediction.
 pub fn edge_residual(link: &ProjectedLink, edge: &EdgePoint) -> f32 {
-    let (_, normal) = axis_frame(&link.a, &link.b);
+    let normal = link.normal();
     let axis = link.b - link.a;
     let s = ((edge.position - link.a).dot(&axis) / axis.norm_squared().max(1e-9)).clamp(0.0, 1.0);
     link.side_radius_at(s, edge.side) - f32::from(edge.side) * normal.dot(&(edge.position - link.a))
@@ -37,7 +37,7 @@ pub fn edge_residual(link: &ProjectedLink, edge: &EdgePoint) -> f32 {
 /// offset at the edge's foot `s`, `(1−s) ∂r0 + s ∂r1 + (r1 − r0) ∂s` (the foot slides when the
 /// link moves along its axis, and the image radius tapers under perspective).
 pub fn edge_row(link: &ProjectedLink, jac: &LinkJacobian, edge: &EdgePoint, row: &mut Row) -> f32 {
-    let (_, normal) = axis_frame(&link.a, &link.b);
+    let normal = link.normal();
     let axis = link.b - link.a;
     let len2 = axis.norm_squared().max(1e-9);
     let rel = edge.position - link.a;
@@ -83,7 +83,7 @@ pub fn line_row(
 /// The tip residual (Eq. 2.19, along the image axis) of a fingertip found at `tip` (px):
 /// predicted minus measured distance beyond `b`, and its derivative row.
 pub fn tip_row(link: &ProjectedLink, jac: &LinkJacobian, tip: &Vector2<f32>, row: &mut Row) -> f32 {
-    let (dir, _) = axis_frame(&link.a, &link.b);
+    let (dir, _) = link.axis_frame();
     row.clear();
     for k in 0..jac.states.len() {
         let _ = row.push((jac.states[k], dir.dot(&jac.db[k]) + jac.dr1[k]));

@@ -3,7 +3,7 @@
 use heapless::Vec;
 use nalgebra::Vector2;
 
-use super::{axis_frame, LinkFeatures, MAX_LINK_EDGES};
+use super::{LinkFeatures, MAX_LINK_EDGES};
 use crate::projection::ProjectedLink;
 
 /// Fits the axis line of a link through its edge points, each moved toward the axis by the
@@ -13,7 +13,7 @@ pub fn fit_axis_line(
     link: &ProjectedLink,
     features: &LinkFeatures,
 ) -> Option<(Vector2<f32>, Vector2<f32>)> {
-    let (_, normal) = axis_frame(&link.a, &link.b);
+    let normal = link.normal();
     let axis = link.b - link.a;
     let len2 = axis.norm_squared().max(1e-9);
     let mut points: Vec<Vector2<f32>, MAX_LINK_EDGES> = Vec::new();
