@@ -5,7 +5,7 @@ use heapless::Vec;
 use nalgebra::{Matrix3, Vector2, Vector3};
 
 use crate::camera::Camera;
-use crate::config::MAX_FRAMES;
+use crate::config::MAX_LINKS;
 use crate::kinematics::Poses;
 use crate::model::{Model, Shape};
 
@@ -193,7 +193,7 @@ pub struct SkipCounts {
 #[derive(Debug, Clone)]
 pub struct ProjectedModel {
     /// Links in view, in table order.
-    pub links: Vec<ProjectedLink, MAX_FRAMES>,
+    pub links: Vec<ProjectedLink, MAX_LINKS>,
     /// The palm box, when the model has one in view.
     pub palm: Option<ProjectedPalm>,
     /// Links left out, and why.

@@ -10,7 +10,7 @@ use core::fmt;
 use heapless::Vec;
 
 use crate::camera::{Camera, CameraError};
-use crate::config::{MAX_CAMERAS, MAX_FRAMES, MAX_STATES};
+use crate::config::{MAX_CAMERAS, MAX_LINKS, MAX_STATES};
 use crate::estimator::{
     add_link_rows, apply_step, EstimatorConfig, FreeMask, LinkJacobian, NormalEquations,
 };
@@ -160,9 +160,10 @@ struct Workspace {
     features: LinkFeatures,
     jacobian: LinkJacobian,
     normal: NormalEquations,
-    /// `reach[camera][frame]`: what the last search of link `frame` in this frame needed
+    /// `reach[camera][link]`: what the last search of the link starting at model row `link`
+    /// needed in this video frame
     /// ([`LinkFeatures::reach_px`]), infinite when unknown; sizes the next window.
-    reach: [[f32; MAX_FRAMES]; MAX_CAMERAS],
+    reach: [[f32; MAX_LINKS]; MAX_CAMERAS],
 }
 
 /// Tracks one hand over frames from one or more calibrated cameras.
@@ -213,7 +214,7 @@ impl Tracker {
                 features: LinkFeatures::default(),
                 jacobian: LinkJacobian::default(),
                 normal: NormalEquations::new(),
-                reach: [[f32::INFINITY; MAX_FRAMES]; MAX_CAMERAS],
+                reach: [[f32::INFINITY; MAX_LINKS]; MAX_CAMERAS],
             },
         };
         tracker.reset(initial)?;
@@ -231,7 +232,7 @@ impl Tracker {
         let cameras = checked_cameras(cameras)?;
         self.cameras = cameras;
         self.config = config;
-        self.work.reach = [[f32::INFINITY; MAX_FRAMES]; MAX_CAMERAS];
+        self.work.reach = [[f32::INFINITY; MAX_LINKS]; MAX_CAMERAS];
         Ok(())
     }
 
@@ -292,7 +293,7 @@ impl Tracker {
         let predicted = self.predicted();
         let mut q = predicted.clone();
         let mut report = FrameReport::default();
-        self.work.reach = [[f32::INFINITY; MAX_FRAMES]; MAX_CAMERAS];
+        self.work.reach = [[f32::INFINITY; MAX_LINKS]; MAX_CAMERAS];
         for k in 0..self.config.iterations.max(1) {
             let Some(step) = self.iterate(&q, &predicted, frames, k > 0, &mut report) else {
                 report.lost = true;
@@ -459,11 +460,11 @@ impl Tracker {
             let skipped = view.skipped;
             report.links_skipped += skipped.behind + skipped.end_on + skipped.off_frame;
             for index in 0..view.links.len() {
-                let frame_index = usize::from(view.links[index].frame);
+                let link_row = usize::from(view.links[index].frame);
                 let mut features = config.features;
                 if refine {
                     // Coarse to fine: the window this link's last search needed, plus margin.
-                    let reach = reach.get(frame_index).copied().unwrap_or(f32::INFINITY);
+                    let reach = reach.get(link_row).copied().unwrap_or(f32::INFINITY);
                     let need =
                         2.0 * (reach + features.refine_margin_px) + MIN_WINDOW_SAMPLES as f32;
                     if need < f32::from(features.window_px) {
@@ -476,7 +477,7 @@ impl Tracker {
                 report.features_found += found;
                 report.features_expected += work.features.expected;
                 report.features_masked += work.features.masked;
-                if let Some(r) = reach.get_mut(frame_index) {
+                if let Some(r) = reach.get_mut(link_row) {
                     *r = if found == 0 {
                         f32::INFINITY
                     } else {

@@ -442,15 +442,7 @@ where
     }
 
     fn report_drop(&mut self, dropped: Dropped) -> Result<(), S::Error> {
-        let counts = &mut self.stats.dropped;
-        match dropped.reason {
-            DropReason::Incomplete => counts.incomplete += 1,
-            DropReason::WrongSize(..) => counts.wrong_size += 1,
-            DropReason::TooLarge => counts.too_large += 1,
-            DropReason::NotReady => counts.not_ready += 1,
-            DropReason::Superseded => counts.superseded += 1,
-            DropReason::TrackerError => counts.tracker_error += 1,
-        }
+        self.stats.dropped.record(&dropped.reason);
         if matches!(
             dropped.reason,
             DropReason::WrongSize(..) | DropReason::TooLarge
@@ -470,7 +462,7 @@ where
             capacities: Capacities {
                 states: model.map_or(0, |m| m.n_states() as u8),
                 max_states: digiteyes_core::config::MAX_STATES as u8,
-                max_frames: digiteyes_core::config::MAX_FRAMES as u8,
+                max_links: digiteyes_core::config::MAX_LINKS as u8,
                 max_frame_bytes: u32::try_from(self.frame.len()).unwrap_or(u32::MAX),
                 max_chunk: MAX_CHUNK as u16,
                 max_message: MAX_MESSAGE as u16,
