@@ -44,6 +44,18 @@ impl StateKind {
     }
 }
 
+impl StateKind {
+    /// The one of three per-kind values (weights, units, …) that applies to this kind.
+    #[inline]
+    pub fn pick<T>(self, quaternion: T, translation: T, joint: T) -> T {
+        match self {
+            StateKind::Quaternion => quaternion,
+            StateKind::Translation => translation,
+            StateKind::Joint => joint,
+        }
+    }
+}
+
 /// Scales the quaternion at the head of `q` to unit length; leaves `q` as it is when it is
 /// shorter than a quaternion or the quaternion is zero or not finite.
 #[inline]

@@ -152,6 +152,17 @@ fn normal_matrix(ne: &NormalEquations, free: FreeMask, n: usize) -> Vec<Vec<f32>
         .collect()
 }
 
+/// The largest difference between two matrices, relative to the second's largest entry.
+fn relative_difference(h: &[Vec<f32>], h_ref: &[Vec<f32>]) -> f32 {
+    let scale = max_abs(h_ref.iter().flatten().copied());
+    max_abs(
+        h.iter()
+            .flatten()
+            .zip(h_ref.iter().flatten())
+            .map(|(a, b)| a - b),
+    ) / scale
+}
+
 fn max_abs(v: impl Iterator<Item = f32>) -> f32 {
     v.fold(0.0, |m, x| m.max(x.abs()))
 }
@@ -208,13 +219,7 @@ fn the_tracker_and_the_oracle_build_the_same_normal_equations_for_every_wire_res
                         normal_matrix(&tracker, free, n),
                         normal_matrix(&oracle, free, n),
                     );
-                    let scale = max_abs(h_ref.iter().flatten().copied());
-                    let diff = max_abs(
-                        h.iter()
-                            .flatten()
-                            .zip(h_ref.iter().flatten())
-                            .map(|(a, b)| a - b),
-                    ) / scale;
+                    let diff = relative_difference(&h, &h_ref);
                     assert!(diff <= NORMAL_TOLERANCE, "{what}: JᵀWJ differs by {diff}");
                     let conditioning = config.conditioning;
                     let step = tracker
@@ -298,12 +303,6 @@ fn a_wrong_coefficient_would_be_caught() {
     assert_eq!(tips.tips, 5, "five fingertips found");
     let h = normal_matrix(&a, free, n);
     let h_ref = normal_matrix(&b, free, n);
-    let scale = max_abs(h_ref.iter().flatten().copied());
-    let diff = max_abs(
-        h.iter()
-            .flatten()
-            .zip(h_ref.iter().flatten())
-            .map(|(x, y)| x - y),
-    ) / scale;
+    let diff = relative_difference(&h, &h_ref);
     assert!(diff > 100.0 * NORMAL_TOLERANCE, "{diff}");
 }

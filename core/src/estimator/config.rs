@@ -69,11 +69,7 @@ impl Conditioning {
     /// `S` for state `i`.
     #[inline]
     pub fn for_state(&self, i: usize) -> f32 {
-        match StateKind::of(i) {
-            StateKind::Quaternion => self.quaternion,
-            StateKind::Translation => self.translation,
-            StateKind::Joint => self.joint,
-        }
+        StateKind::of(i).pick(self.quaternion, self.translation, self.joint)
     }
 }
 
