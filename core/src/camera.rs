@@ -106,6 +106,13 @@ impl Camera {
         (uv.x.is_finite() && uv.y.is_finite()).then_some(uv)
     }
 
+    /// The ray through pixel `uv` in camera coordinates, scaled to depth 1:
+    /// `((u − cx) / fx, (v − cy) / fy, 1)` — the inverse of [`Camera::project`] up to depth.
+    #[inline]
+    pub fn ray(&self, uv: &Vector2<f32>) -> Vector3<f32> {
+        Vector3::new((uv.x - self.cx) / self.fx, (uv.y - self.cy) / self.fy, 1.0)
+    }
+
     /// Pixel of a world point, its depth `z_c` (mm), and `∂(u, v)/∂p_w` (px/mm); `None` where
     /// [`Camera::project`] would, for the same reasons.
     pub fn project_with_jacobian(

@@ -1,7 +1,8 @@
 //! Capacities: every fixed-size buffer in the core is sized by one of these constants.
 
-/// Most link frames a model may have (the whole hand has 37).
-pub const MAX_FRAMES: usize = 48;
+/// Most links (rows of `hand.dh`, each a coordinate frame) a model may have (the whole hand
+/// has 37). Named for links, not video frames.
+pub const MAX_LINKS: usize = 48;
 /// Most states a model may have (the whole hand has 28).
 pub const MAX_STATES: usize = 32;
 /// Most frames one frame's `next` list may name (the palm names 5).

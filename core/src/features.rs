@@ -18,6 +18,9 @@ use crate::projection::Bounds;
 use crate::projection::ProjectedModel;
 use crate::visibility::{candidates, cover_among, Cover};
 
+mod axis_line;
+pub use axis_line::fit_axis_line;
+
 /// Which sign of intensity change, going outward across an edge, counts as an edge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -72,6 +75,16 @@ impl Default for FeatureConfig {
     }
 }
 
+/// Fewest samples a search window has: the smoothed derivative needs 2 samples each side of a
+/// point, and the peak test one more derivative each side (so [`find_edge`] finds nothing in
+/// fewer). Windows asked for smaller are widened to this.
+pub const MIN_WINDOW_SAMPLES: usize = 7;
+
+/// How far beyond a predicted edge (outward) or tip the occlusion mask is probed to tell an
+/// edge over the background from one over a farther part of the hand (px). The region of
+/// links tested for cover is grown by the same distance, so every probe lies inside it.
+pub const PROBE_BEYOND_EDGE_PX: f32 = 2.0;
+
 /// An edge found along a 1-D profile.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -87,7 +100,7 @@ pub struct Edge {
 /// and the peak is refined by a parabola. `None` when no peak reaches `min_contrast`.
 pub fn find_edge(profile: &[f32], polarity: Polarity, min_contrast: f32) -> Option<Edge> {
     let n = profile.len();
-    if n < 7 {
+    if n < MIN_WINDOW_SAMPLES {
         return None;
     }
     let mut derivative = [0.0f32; MAX_WINDOW];
@@ -217,17 +230,7 @@ pub struct LinkFeatures {
     pub reach_px: f32,
 }
 
-/// Unit axis direction and normal `(−d_y, d_x)` of a link in the image.
-pub fn axis_frame(a: &Vector2<f32>, b: &Vector2<f32>) -> (Vector2<f32>, Vector2<f32>) {
-    let d = b - a;
-    let len = d.norm();
-    let dir = if len > 1e-6 {
-        d / len
-    } else {
-        Vector2::new(1.0, 0.0)
-    };
-    (dir, Vector2::new(-dir.y, dir.x))
-}
+pub use crate::projection::axis_frame;
 
 /// What became of one search window of [`find_link_features`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -309,9 +312,9 @@ fn search_link<W: FnMut(&SearchWindow)>(
     let Some(link) = view.links.get(index) else {
         return;
     };
-    let window = usize::from(config.window_px).clamp(7, MAX_WINDOW);
+    let window = usize::from(config.window_px).clamp(MIN_WINDOW_SAMPLES, MAX_WINDOW);
     let half = (window - 1) as f32 * 0.5;
-    let (dir, normal) = axis_frame(&link.a, &link.b);
+    let (dir, normal) = link.axis_frame();
     let slices = usize::from(config.slices_per_link).clamp(1, MAX_SLICES_PER_LINK);
     let mut profile = [0.0f32; MAX_WINDOW];
     let slice_s = |k: usize| {
@@ -321,13 +324,13 @@ fn search_link<W: FnMut(&SearchWindow)>(
             config.span[0] + (config.span[1] - config.span[0]) * k as f32 / (slices - 1) as f32
         }
     };
-    // Every point `cover` is asked about (the predicted edges and tip, and 2 px beyond each)
-    // lies within the link's own bounds grown by 2 px, so only the links and palm whose
-    // bounds meet that box are tested.
+    // Every point `cover` is asked about (the predicted edges and tip, and
+    // `PROBE_BEYOND_EDGE_PX` beyond each) lies within the link's own bounds grown by that
+    // distance, so only the links and palm whose bounds meet that box are tested.
     let (among, palm) = if config.mask_occluded {
-        let reach = Vector2::new(2.0, 2.0);
+        let reach = Vector2::new(PROBE_BEYOND_EDGE_PX, PROBE_BEYOND_EDGE_PX);
         let tip = if config.tips && link.distal {
-            link.b + dir * (link.tip_offset + 2.0)
+            link.b + dir * (link.tip_offset + PROBE_BEYOND_EDGE_PX)
         } else {
             link.b
         };
@@ -363,9 +366,14 @@ fn search_link<W: FnMut(&SearchWindow)>(
                 }
                 Cover::Behind => over_hand = true,
                 Cover::Clear => {
-                    over_hand =
-                        cover_among(view, camera, &among, palm, &(centre + outward * 2.0), depth)
-                            != Cover::Clear;
+                    over_hand = cover_among(
+                        view,
+                        camera,
+                        &among,
+                        palm,
+                        &(centre + outward * PROBE_BEYOND_EDGE_PX),
+                        depth,
+                    ) != Cover::Clear;
                 }
             }
         }

@@ -14,7 +14,7 @@ use core::fmt;
 use heapless::Vec;
 use nalgebra::{Matrix3, Vector3};
 
-use crate::config::{MAX_FRAMES, MAX_ROW_NONZEROS};
+use crate::config::{MAX_LINKS, MAX_ROW_NONZEROS};
 use crate::model::{Model, Theta, BASE_STATES};
 use crate::quaternion;
 
@@ -99,7 +99,7 @@ impl core::error::Error for KinematicsError {}
 #[derive(Debug, Clone)]
 pub struct Poses {
     /// `frame[i]`: frame `i` in the world (`W_i`).
-    frame: [Pose; MAX_FRAMES],
+    frame: [Pose; MAX_LINKS],
     /// `E_k = D_k · Rᵀ`: `∂p/∂q_k = E_k (p − t_palm)` for the quaternion states k = 0..3.
     quat_derivative: [Matrix3<f32>; 4],
     n_frames: usize,
@@ -109,7 +109,7 @@ impl Poses {
     /// Poses of every frame of `model` for states `q` (quaternion, mm, rad).
     pub fn compute(model: &Model, q: &[f32]) -> Result<Poses, KinematicsError> {
         let mut poses = Poses {
-            frame: [Pose::identity(); MAX_FRAMES],
+            frame: [Pose::identity(); MAX_LINKS],
             quat_derivative: [Matrix3::zeros(); 4],
             n_frames: model.links().len(),
         };

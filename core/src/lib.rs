@@ -14,7 +14,9 @@
 //! - [`camera`]: calibrated pinhole cameras and their projection derivative.
 //! - [`frame`]: a borrowed 8-bit frame and bounds-checked sub-pixel sampling.
 //! - [`features`]: the slice edge search of Sec. 4.3.1 with occlusion masking.
-//! - [`estimator`]: residuals, row-by-row normal equations, conditioned Gauss–Newton (Eq. 2.22).
+//! - [`estimator`]: residuals gathered per link into the normal equations, conditioned
+//!   Gauss–Newton solved by `LDLᵀ` (Eq. 2.22); [`estimator::reference`] is the oracle.
+//! - [`state`]: the state vector's layout (palm quaternion, translation, joints).
 //! - [`motion`]: the prediction between frames, the prior toward it, what a lost frame keeps.
 //! - [`silhouette`]: how well the projected silhouette agrees with the image (region evidence).
 //! - [`likelihood`]: how well a hypothesised state explains a frame (oriented chamfer + silhouette).
@@ -52,6 +54,7 @@ pub mod quaternion;
 pub mod remote;
 pub mod search;
 pub mod silhouette;
+pub mod state;
 pub mod tracker;
 pub mod visibility;
 

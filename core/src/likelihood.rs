@@ -15,7 +15,7 @@ use core::fmt;
 use heapless::Vec;
 
 use crate::camera::Camera;
-use crate::config::MAX_FRAMES;
+use crate::config::MAX_LINKS;
 use crate::frame::FrameView;
 use crate::nalgebra::Vector2;
 use crate::projection::ProjectedModel;
@@ -283,7 +283,7 @@ pub struct Likelihood {
 }
 
 /// Most silhouette points one view yields: two lines per link, at most 16 points each.
-pub const MAX_SAMPLES: usize = MAX_FRAMES * 2 * MAX_SAMPLES_PER_LINE;
+pub const MAX_SAMPLES: usize = MAX_LINKS * 2 * MAX_SAMPLES_PER_LINE;
 
 /// Most points sampled along one silhouette line.
 pub const MAX_SAMPLES_PER_LINE: usize = 16;

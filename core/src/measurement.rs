@@ -7,8 +7,8 @@
 use heapless::Vec;
 
 use crate::camera::Camera;
-use crate::config::MAX_FRAMES;
-use crate::estimator::fit_axis_line;
+use crate::config::MAX_LINKS;
+use crate::features::fit_axis_line;
 use crate::features::{find_link_features, FeatureConfig, LinkFeatures};
 use crate::frame::FrameView;
 use crate::kinematics::Poses;
@@ -26,7 +26,7 @@ pub fn measure_links(
     q: &[f32],
     frame: &FrameView<'_>,
     config: &FeatureConfig,
-) -> Vec<LinkMeasurement, MAX_FRAMES> {
+) -> Vec<LinkMeasurement, MAX_LINKS> {
     let mut out = Vec::new();
     let Ok(poses) = Poses::compute(model, q) else {
         return out;

@@ -20,7 +20,7 @@ use core::fmt;
 
 use heapless::{String, Vec};
 
-use crate::config::{MAX_CHAIN, MAX_CHILDREN, MAX_FRAMES, MAX_NAME_LEN, MAX_STATES};
+use crate::config::{MAX_CHAIN, MAX_CHILDREN, MAX_LINKS, MAX_NAME_LEN, MAX_STATES};
 
 /// The whole-hand model of the thesis (Table 2.1 / Appendix A) with the corrections of
 /// `docs/hand-model.md` and the joint ranges of the project's test sequences.
@@ -102,15 +102,15 @@ pub struct Limit {
     pub hi: f32,
 }
 
-/// A parsed kinematic model: a tree of at most [`MAX_FRAMES`] frames and [`MAX_STATES`] states.
+/// A parsed kinematic model: a tree of at most [`MAX_LINKS`] frames and [`MAX_STATES`] states.
 ///
 /// Invariants (checked by [`Model::parse`]): frames are numbered 0.. in order; frame 0 is the
 /// `base`; every other frame has exactly one parent; the tree has no cycle; joint states are
 /// numbered q7, q8, ... in table order; `order` lists every frame after its parent.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
-    links: Vec<Link, MAX_FRAMES>,
-    order: Vec<u8, MAX_FRAMES>,
+    links: Vec<Link, MAX_LINKS>,
+    order: Vec<u8, MAX_LINKS>,
     state_frame: [u8; MAX_STATES],
     limits: [Option<Limit>; MAX_STATES],
     n_states: u8,
@@ -173,9 +173,9 @@ pub enum ModelErrorKind {
         /// The frame.
         frame: u16,
     },
-    /// More than [`MAX_FRAMES`] frames.
+    /// More than [`MAX_LINKS`] frames.
     TooManyFrames,
-    /// `next` names a frame number at or past [`MAX_FRAMES`]: no model can have it.
+    /// `next` names a frame number at or past [`MAX_LINKS`]: no model can have it.
     FrameBeyondLimit {
         /// The frame named.
         frame: u16,
@@ -220,14 +220,14 @@ impl fmt::Display for ModelErrorKind {
             Self::TooManyFrames => {
                 write!(
                     f,
-                    "more than {MAX_FRAMES} frames (a model has at most {MAX_FRAMES})"
+                    "more than {MAX_LINKS} frames (a model has at most {MAX_LINKS})"
                 )
             }
             Self::FrameBeyondLimit { frame } => write!(
                 f,
-                "`next` names frame {frame}, but a model has at most {MAX_FRAMES} frames \
+                "`next` names frame {frame}, but a model has at most {MAX_LINKS} frames \
                  (0 to {})",
-                MAX_FRAMES - 1
+                MAX_LINKS - 1
             ),
             Self::TooManyStates => write!(f, "more than {MAX_STATES} states"),
             Self::TooManyChildren => write!(f, "more than {MAX_CHILDREN} frames in `next`"),
@@ -255,7 +255,7 @@ impl Model {
 
     /// Parses the `hand.dh` format. Never panics; every defect is a [`ModelError`].
     pub fn parse(text: &str) -> Result<Self, ModelError> {
-        let mut links: Vec<Link, MAX_FRAMES> = Vec::new();
+        let mut links: Vec<Link, MAX_LINKS> = Vec::new();
         let mut limits = [None; MAX_STATES];
         let mut state_frame = [0u8; MAX_STATES];
         let mut n_states: usize = 0;
@@ -383,7 +383,7 @@ impl Model {
             }
             cursor = link.parent.map(usize::from);
             steps += 1;
-            if steps > MAX_FRAMES {
+            if steps > MAX_LINKS {
                 return None;
             }
         }
@@ -482,7 +482,7 @@ fn parse_row<'a>(
         let child: u16 = tok
             .parse()
             .map_err(|_| ModelErrorKind::UnknownToken("next"))?;
-        if usize::from(child) >= MAX_FRAMES {
+        if usize::from(child) >= MAX_LINKS {
             return Err(ModelErrorKind::FrameBeyondLimit { frame: child });
         }
         children
@@ -589,7 +589,7 @@ fn parse_length(token: &str, field: &'static str) -> Result<f32, ModelErrorKind>
 }
 
 /// Sets parents from the `next` lists, checks the tree, and returns a parent-first order.
-fn link_tree(links: &mut Vec<Link, MAX_FRAMES>) -> Result<Vec<u8, MAX_FRAMES>, ModelError> {
+fn link_tree(links: &mut Vec<Link, MAX_LINKS>) -> Result<Vec<u8, MAX_LINKS>, ModelError> {
     let n = links.len();
     for i in 0..n {
         let line = links[i].line;
@@ -609,7 +609,7 @@ fn link_tree(links: &mut Vec<Link, MAX_FRAMES>) -> Result<Vec<u8, MAX_FRAMES>, M
             links[c].parent = Some(i as u8);
         }
     }
-    let mut order: Vec<u8, MAX_FRAMES> = Vec::new();
+    let mut order: Vec<u8, MAX_LINKS> = Vec::new();
     let _ = order.push(0);
     let mut head = 0;
     while head < order.len() {

@@ -15,6 +15,8 @@
 //!   prior is negligible, where it has none the state stays where the motion model put it;
 //! - a lost frame does not move the state: the tracker keeps its last good state.
 
+use crate::state::StateKind;
+
 /// Weights of the prior toward the predicted state, per kind of state, in the units of the
 /// normal equations (px² per unit² of the state: per quaternion component², per mm², per
 /// rad²). Zero turns a kind's prior off.
@@ -38,12 +40,9 @@ impl PriorWeights {
     };
 
     /// The weight for state `i`.
+    #[inline]
     pub fn for_state(&self, i: usize) -> f32 {
-        match i {
-            0..=3 => self.quaternion,
-            4..=6 => self.translation,
-            _ => self.joint,
-        }
+        StateKind::of(i).pick(self.quaternion, self.translation, self.joint)
     }
 
     /// True when some kind has a prior.

@@ -5,9 +5,23 @@ use heapless::Vec;
 use nalgebra::{Matrix3, Vector2, Vector3};
 
 use crate::camera::Camera;
-use crate::config::MAX_FRAMES;
+use crate::config::MAX_LINKS;
 use crate::kinematics::Poses;
 use crate::model::{Model, Shape};
+
+/// Unit direction of the image axis from `a` to `b` and its normal `(−d_y, d_x)`; `(1, 0)`
+/// and `(0, 1)` for an axis shorter than 1e-6 px.
+#[inline]
+pub fn axis_frame(a: &Vector2<f32>, b: &Vector2<f32>) -> (Vector2<f32>, Vector2<f32>) {
+    let d = b - a;
+    let len = d.norm();
+    let dir = if len > 1e-6 {
+        d / len
+    } else {
+        Vector2::new(1.0, 0.0)
+    };
+    (dir, Vector2::new(-dir.y, dir.x))
+}
 
 /// An axis-aligned box in the image (px).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,6 +83,28 @@ pub struct ProjectedLink {
 }
 
 impl ProjectedLink {
+    /// Unit direction of the image axis from `a` to `b` and its normal `(−d_y, d_x)`
+    /// ([`axis_frame`]).
+    #[inline]
+    pub fn axis_frame(&self) -> (Vector2<f32>, Vector2<f32>) {
+        axis_frame(&self.a, &self.b)
+    }
+
+    /// Unit normal `(−d_y, d_x)` of the image axis: the direction of side +1.
+    #[inline]
+    pub fn normal(&self) -> Vector2<f32> {
+        self.axis_frame().1
+    }
+
+    /// The silhouette line on side `side` (+1 along [`normal`](Self::normal), −1 opposite),
+    /// from beside `a` to beside `b` (px).
+    #[inline]
+    pub fn silhouette(&self, side: i8) -> (Vector2<f32>, Vector2<f32>) {
+        let k = usize::from(side < 0);
+        let offset = self.normal() * f32::from(side);
+        (self.a + offset * self.r0[k], self.b + offset * self.r1[k])
+    }
+
     /// Image length of the axis (px).
     pub fn length(&self) -> f32 {
         (self.b - self.a).norm()
@@ -123,12 +159,7 @@ impl ProjectedPalm {
         if !self.bounds.contains(p) {
             return None;
         }
-        let ray = Vector3::new(
-            (p.x - camera.cx) / camera.fx,
-            (p.y - camera.cy) / camera.fy,
-            1.0,
-        );
-        let dir = self.to_palm * ray;
+        let dir = self.to_palm * camera.ray(p);
         let (mut t_in, mut t_out) = (0.0f32, f32::INFINITY);
         for k in 0..3 {
             if dir[k].abs() < 1e-12 {
@@ -162,7 +193,7 @@ pub struct SkipCounts {
 #[derive(Debug, Clone)]
 pub struct ProjectedModel {
     /// Links in view, in table order.
-    pub links: Vec<ProjectedLink, MAX_FRAMES>,
+    pub links: Vec<ProjectedLink, MAX_LINKS>,
     /// The palm box, when the model has one in view.
     pub palm: Option<ProjectedPalm>,
     /// Links left out, and why.
@@ -305,13 +336,6 @@ fn project_box(
     })
 }
 
-/// Image normal `(−d_y, d_x)` of the axis from `a` to `b`.
-fn image_normal(a: &Vector2<f32>, b: &Vector2<f32>) -> Vector2<f32> {
-    let d = b - a;
-    let len = d.norm().max(1e-6);
-    Vector2::new(-d.y / len, d.x / len)
-}
-
 /// Offsets (px) from the image axis to the two silhouette lines of the cylinder of radius
 /// `radius` around `p0`–`p1`, at `a` and at `b`, each `[side +1, side −1]`. The silhouette
 /// lines are the images of the two planes through the camera centre tangent to the cylinder;
@@ -346,7 +370,7 @@ fn silhouette_offsets(
     let m = d.cross(&w);
     let sin = radius / dist;
     let cos = libm::sqrtf(1.0 - sin * sin);
-    let normal = image_normal(a, b);
+    let (_, normal) = axis_frame(a, b);
     let mut out = approx;
     for sign in [1.0f32, -1.0] {
         let n_c = camera.r * (m * cos + w * (sign * sin));
@@ -386,14 +410,7 @@ fn sphere_outline_offset(
         return approx;
     }
     let dir = d / len;
-    let ray = |p: Vector2<f32>| {
-        Vector3::new(
-            (p.x - camera.cx) / camera.fx,
-            (p.y - camera.cy) / camera.fy,
-            1.0,
-        )
-        .normalize()
-    };
+    let ray = |p: Vector2<f32>| camera.ray(&p).normalize();
     let to_centre = camera.to_camera(c);
     let dist = to_centre.norm();
     if dist <= radius * 1.001 {

@@ -6,21 +6,17 @@
 //! ([`measurer`](crate::measurer)) keeps its own, so both narrow the windows alike.
 
 use crate::camera::Camera;
-use crate::config::MAX_FRAMES;
-use crate::features::{find_link_features, FeatureConfig, LinkFeatures};
+use crate::config::MAX_LINKS;
+use crate::features::{find_link_features, FeatureConfig, LinkFeatures, MIN_WINDOW_SAMPLES};
 use crate::frame::FrameView;
 use crate::projection::ProjectedModel;
-
-/// Pixels added to a narrowed window beyond twice the reach and margin, so the window still
-/// holds the edge filter's support (the 7-sample minimum of a window).
-pub const WINDOW_MIN_PX: f32 = 7.0;
 
 /// The reach of each link's last search in the current frame.
 #[derive(Debug, Clone, Copy)]
 pub struct CameraSearch {
     /// `reach_px[link]`: how far from its prediction the last search of model link `link`
     /// found something ([`LinkFeatures::reach_px`], px); infinite when unknown.
-    reach_px: [f32; MAX_FRAMES],
+    reach_px: [f32; MAX_LINKS],
 }
 
 impl Default for CameraSearch {
@@ -33,13 +29,13 @@ impl CameraSearch {
     /// A search that knows nothing yet: every window at its configured width.
     pub const fn new() -> Self {
         CameraSearch {
-            reach_px: [f32::INFINITY; MAX_FRAMES],
+            reach_px: [f32::INFINITY; MAX_LINKS],
         }
     }
 
     /// Forgets the reaches: the next searches use the configured windows (a new frame).
     pub fn restart(&mut self) {
-        self.reach_px = [f32::INFINITY; MAX_FRAMES];
+        self.reach_px = [f32::INFINITY; MAX_LINKS];
     }
 
     /// Searches link `index` of `view` on `frame` into `out`. With `refine`, the window is
@@ -67,7 +63,7 @@ impl CameraSearch {
                 .get(link_frame)
                 .copied()
                 .unwrap_or(f32::INFINITY);
-            let need = 2.0 * (reach + features.refine_margin_px) + WINDOW_MIN_PX;
+            let need = 2.0 * (reach + features.refine_margin_px) + MIN_WINDOW_SAMPLES as f32;
             if need < f32::from(features.window_px) {
                 features.window_px = libm::ceilf(need) as u8;
             }

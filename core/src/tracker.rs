@@ -21,6 +21,7 @@ use crate::measurer::{LocalFrames, Measurer};
 use crate::model::Model;
 use crate::motion::{velocity_trust, MotionConfig};
 use crate::projection::ProjectedModel;
+use crate::state::{clamp_to_limit, renormalise_quaternion, TRANSLATION};
 
 /// The cameras, if there are 1 to [`MAX_CAMERAS`] and each is usable.
 fn checked_cameras(cameras: &[Camera]) -> Result<Vec<Camera, MAX_CAMERAS>, TrackerError> {
@@ -117,9 +118,11 @@ pub struct FrameReport {
 }
 
 /// Why the tracker could not be set up or could not use a frame.
+///
+/// Exhaustive on purpose: a board maps each to a wire `Refusal`, and a new kind of error must
+/// be given one there.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[non_exhaustive]
 pub enum TrackerError {
     /// No cameras, or more than [`MAX_CAMERAS`].
     CameraCount,
@@ -131,7 +134,7 @@ pub enum TrackerError {
     Frame(FrameError),
     /// The state is unusable.
     State(KinematicsError),
-    /// A `free` entry names no state of the model.
+    /// The free mask names a state the model does not have (the first such).
     BadFreeState(u8),
 }
 
@@ -179,33 +182,20 @@ pub struct Tracker {
 
 impl Tracker {
     /// A tracker starting from `initial` (one value per model state: quaternion, mm, rad),
-    /// estimating the states listed in `free` (all when `None`). Naming any quaternion state
-    /// frees all four.
+    /// estimating the states in `free` ([`FreeMask::all`] for every state). Freeing any
+    /// quaternion state frees all four.
     pub fn new(
         model: Model,
         cameras: &[Camera],
         initial: &[f32],
-        free: Option<&[u8]>,
+        free: FreeMask,
         config: TrackerConfig,
     ) -> Result<Self, TrackerError> {
         let cameras = checked_cameras(cameras)?;
-        let n = model.n_states();
-        let mask = match free {
-            None => FreeMask::all(n),
-            Some(list) => {
-                let mut m = 0u32;
-                for &s in list {
-                    if usize::from(s) >= n {
-                        return Err(TrackerError::BadFreeState(s));
-                    }
-                    m |= 1 << s;
-                }
-                if m & 0b1111 != 0 {
-                    m |= 0b1111;
-                }
-                FreeMask(m)
-            }
-        };
+        if let Some(s) = free.first_beyond(model.n_states()) {
+            return Err(TrackerError::BadFreeState(s));
+        }
+        let mask = free.with_whole_quaternion();
         let poses = Poses::compute(&model, initial).map_err(TrackerError::State)?;
         let mut tracker = Tracker {
             model,
@@ -249,9 +239,7 @@ impl Tracker {
             .map_err(TrackerError::State)?;
         self.state.clear();
         let _ = self.state.extend_from_slice(state);
-        if let Some(u) = crate::quaternion::normalised([state[0], state[1], state[2], state[3]]) {
-            self.state[..4].copy_from_slice(&u);
-        }
+        renormalise_quaternion(&mut self.state);
         // The silhouette reference is the images' level, not the motion's: it stays.
         self.velocity = None;
         Ok(())
@@ -382,7 +370,10 @@ impl Tracker {
     /// Whether the palm's origin at `q` projects into some camera's frame, grown by
     /// [`VIEW_SLACK`] of its size on each side: a hand the cameras see cannot be out there.
     fn palm_in_view(&self, q: &[f32]) -> bool {
-        let Some(&[x, y, z]) = q.get(4..7).and_then(|t| <&[f32; 3]>::try_from(t).ok()) else {
+        let Some(&[x, y, z]) = q
+            .get(TRANSLATION)
+            .and_then(|t| <&[f32; 3]>::try_from(t).ok())
+        else {
             return false;
         };
         let p = nalgebra::Vector3::new(x, y, z);
@@ -441,15 +432,10 @@ impl Tracker {
         if let (true, Some(velocity)) = (self.config.predict, &self.velocity) {
             for (i, v) in q.iter_mut().enumerate() {
                 if self.free.contains(i) {
-                    *v += velocity[i];
-                    if let Some(limit) = self.model.limit(i) {
-                        *v = v.clamp(limit.lo, limit.hi);
-                    }
+                    *v = clamp_to_limit(&self.model, i, *v + velocity[i]);
                 }
             }
-            if let Some(u) = crate::quaternion::normalised([q[0], q[1], q[2], q[3]]) {
-                q[..4].copy_from_slice(&u);
-            }
+            renormalise_quaternion(&mut q);
         }
         q
     }

@@ -41,7 +41,7 @@ pub fn candidates(
     view: &ProjectedModel,
     link: usize,
     region: &crate::projection::Bounds,
-) -> (heapless::Vec<u8, { crate::config::MAX_FRAMES }>, bool) {
+) -> (heapless::Vec<u8, { crate::config::MAX_LINKS }>, bool) {
     let meets = |b: &crate::projection::Bounds| {
         b.min.x <= region.max.x
             && b.max.x >= region.min.x

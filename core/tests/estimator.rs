@@ -2,8 +2,9 @@
 //! against a dense computation, robust weights and the axis-line fit.
 
 use digiteyes_core::camera::Camera;
+use digiteyes_core::estimator::reference::*;
 use digiteyes_core::estimator::*;
-use digiteyes_core::features::{axis_frame, EdgePoint, LinkFeatures};
+use digiteyes_core::features::{axis_frame, fit_axis_line, EdgePoint, LinkFeatures};
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Model;
 use digiteyes_core::projection::{ProjectedLink, ProjectedModel};

@@ -52,7 +52,13 @@ fn check_model(model: &Model) {
         let p = poses.origin(f).unwrap();
         // Far-fetched tables (lengths up to f32::MAX) may overflow to inf; no panic either way.
         let d = poses.point_derivatives(model, f, &(p + Vector3::new(1.0, 2.0, 3.0)));
-        assert!(d.len() >= 7);
+        // A point on frame `f` moves with the seven palm states, then with exactly the joints
+        // of `f`'s chain, root first: every one a state of the model.
+        let states: Vec<u8> = d.iter().map(|(s, _)| *s).collect();
+        let mut expected: Vec<u8> = (0..7).collect();
+        expected.extend(model.chain(f).unwrap());
+        assert_eq!(states, expected, "states moving a point on frame {f}");
+        assert!(states.iter().all(|&s| usize::from(s) < model.n_states()));
     }
 }
 

@@ -1,7 +1,7 @@
 //! The `hand.dh` parser and writer: the built-in hand against `docs/hand-model.md`, round trips, and
 //! every error path of `ModelErrorKind` with the line it is reported on.
 
-use digiteyes_core::config::{MAX_CHAIN, MAX_FRAMES, MAX_NAME_LEN, MAX_STATES};
+use digiteyes_core::config::{MAX_CHAIN, MAX_LINKS, MAX_NAME_LEN, MAX_STATES};
 use digiteyes_core::model::{
     Limit, Model, ModelError, ModelErrorKind, Shape, Theta, BASE_STATES, DEFAULT_BOX_CENTRE,
     HAND_DH,
@@ -620,25 +620,25 @@ fn constant_chain(n: usize) -> String {
 #[test]
 fn too_many_frames() {
     assert!(
-        Model::parse(&constant_chain(MAX_FRAMES)).is_ok(),
-        "exactly MAX_FRAMES fit"
+        Model::parse(&constant_chain(MAX_LINKS)).is_ok(),
+        "exactly MAX_LINKS fit"
     );
-    // One row more (unreferenced: naming frame MAX_FRAMES in a `next` is FrameBeyondLimit).
-    let text = constant_chain(MAX_FRAMES) + &format!("{MAX_FRAMES} extra 0 0 0 0 - -\n");
-    assert_error(&text, MAX_FRAMES as u32 + 1, ModelErrorKind::TooManyFrames);
-    // A chain of MAX_FRAMES + 1 frames: its last `next` names frame MAX_FRAMES, and the
+    // One row more (unreferenced: naming frame MAX_LINKS in a `next` is FrameBeyondLimit).
+    let text = constant_chain(MAX_LINKS) + &format!("{MAX_LINKS} extra 0 0 0 0 - -\n");
+    assert_error(&text, MAX_LINKS as u32 + 1, ModelErrorKind::TooManyFrames);
+    // A chain of MAX_LINKS + 1 frames: its last `next` names frame MAX_LINKS, and the
     // message says why that cannot be, not that the frame is missing.
-    let text = constant_chain(MAX_FRAMES + 1);
+    let text = constant_chain(MAX_LINKS + 1);
     let e = error(&text);
     assert_eq!(
         e.kind,
         ModelErrorKind::FrameBeyondLimit {
-            frame: MAX_FRAMES as u16
+            frame: MAX_LINKS as u16
         }
     );
     assert!(
         e.to_string()
-            .contains(&format!("at most {MAX_FRAMES} frames")),
+            .contains(&format!("at most {MAX_LINKS} frames")),
         "{e}"
     );
 }

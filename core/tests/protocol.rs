@@ -43,7 +43,7 @@ fn board_messages() -> std::vec::Vec<BoardMessage> {
             capacities: Capacities {
                 states: 28,
                 max_states: 32,
-                max_frames: 48,
+                max_links: 48,
                 max_frame_bytes: 640 * 480,
                 max_chunk: MAX_CHUNK as u16,
                 max_message: MAX_MESSAGE as u16,
@@ -424,4 +424,38 @@ fn the_size_limit_counts_both_delimiters() {
     }
     assert_eq!(outcomes, [Ok(()), Err(LinkError::Overflow), Ok(())]);
     assert_eq!(rx.counters().overflows, 1);
+}
+
+#[test]
+fn drop_counts_record_each_reason_in_its_counter_and_total_them() {
+    use digiteyes_core::protocol::{DropCounts, DropReason};
+    let mut counts = DropCounts::default();
+    let reasons = [
+        DropReason::Incomplete,
+        DropReason::WrongSize(1, 2),
+        DropReason::TooLarge,
+        DropReason::NotReady,
+        DropReason::Superseded,
+        DropReason::TrackerError,
+    ];
+    for (k, reason) in reasons.iter().enumerate() {
+        for _ in 0..=k {
+            counts.record(reason);
+        }
+    }
+    assert_eq!(
+        counts,
+        DropCounts {
+            incomplete: 1,
+            wrong_size: 2,
+            too_large: 3,
+            not_ready: 4,
+            superseded: 5,
+            tracker_error: 6,
+        }
+    );
+    assert_eq!(counts.total(), 21);
+    counts.tracker_error = u32::MAX;
+    counts.record(&DropReason::TrackerError);
+    assert_eq!((counts.tracker_error, counts.total()), (u32::MAX, u32::MAX));
 }

@@ -85,7 +85,7 @@ fn board_messages() -> Vec<(&'static str, BoardMessage)> {
                 capacities: Capacities {
                     states: 28,
                     max_states: 32,
-                    max_frames: 48,
+                    max_links: 48,
                     max_frame_bytes: 307_200,
                     max_chunk: 1024,
                     max_message: 1408,

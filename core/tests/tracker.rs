@@ -1,6 +1,7 @@
 //! The tracker's error paths and its behaviour on frames with nothing to track.
 
 use digiteyes_core::camera::{Camera, CameraError};
+use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::{FrameError, FrameView};
 use digiteyes_core::kinematics::KinematicsError;
 use digiteyes_core::model::Model;
@@ -26,7 +27,7 @@ fn initial() -> Vec<f32> {
     q
 }
 
-fn tracker(free: Option<&[u8]>) -> Result<Tracker, TrackerError> {
+fn tracker(free: FreeMask) -> Result<Tracker, TrackerError> {
     Tracker::new(
         Model::hand().unwrap(),
         &[camera()],
@@ -38,7 +39,7 @@ fn tracker(free: Option<&[u8]>) -> Result<Tracker, TrackerError> {
 
 #[test]
 fn a_frame_of_the_wrong_size_is_rejected_and_the_state_kept() {
-    let mut t = tracker(None).unwrap();
+    let mut t = tracker(FreeMask::all(28)).unwrap();
     let data = vec![0u8; 32 * 48];
     let frame = FrameView::packed(&data, 32, 48).unwrap();
     let before = t.state().to_vec();
@@ -54,7 +55,7 @@ fn a_frame_of_the_wrong_size_is_rejected_and_the_state_kept() {
 
 #[test]
 fn the_number_of_frames_must_match_the_cameras() {
-    let mut t = tracker(None).unwrap();
+    let mut t = tracker(FreeMask::all(28)).unwrap();
     let data = vec![0u8; 64 * 48];
     let frame = FrameView::packed(&data, 64, 48).unwrap();
     assert_eq!(t.track(&[]), Err(TrackerError::FrameCount));
@@ -64,7 +65,7 @@ fn the_number_of_frames_must_match_the_cameras() {
 #[test]
 fn set_up_errors() {
     assert_eq!(
-        tracker(Some(&[4, 28])).err(),
+        tracker(FreeMask::from_states(&[4, 28]).unwrap()).err(),
         Some(TrackerError::BadFreeState(28))
     );
     let mut nan = initial();
@@ -73,7 +74,7 @@ fn set_up_errors() {
         Model::hand().unwrap(),
         &[camera()],
         &nan,
-        None,
+        FreeMask::all(28),
         TrackerConfig::default(),
     );
     assert_eq!(
@@ -84,7 +85,7 @@ fn set_up_errors() {
         Model::hand().unwrap(),
         &[camera()],
         &initial()[..20],
-        None,
+        FreeMask::all(28),
         TrackerConfig::default(),
     );
     assert!(matches!(
@@ -95,7 +96,7 @@ fn set_up_errors() {
         Model::hand().unwrap(),
         &[],
         &initial(),
-        None,
+        FreeMask::all(28),
         TrackerConfig::default(),
     );
     assert_eq!(r.err(), Some(TrackerError::CameraCount));
@@ -105,7 +106,7 @@ fn set_up_errors() {
         Model::hand().unwrap(),
         &[bad],
         &initial(),
-        None,
+        FreeMask::all(28),
         TrackerConfig::default(),
     );
     assert_eq!(
@@ -117,7 +118,7 @@ fn set_up_errors() {
         Model::hand().unwrap(),
         &five,
         &initial(),
-        None,
+        FreeMask::all(28),
         TrackerConfig::default(),
     );
     assert_eq!(r.err(), Some(TrackerError::CameraCount));
@@ -125,7 +126,7 @@ fn set_up_errors() {
 
 #[test]
 fn naming_one_quaternion_state_frees_all_four() {
-    let t = tracker(Some(&[2, 8])).unwrap();
+    let t = tracker(FreeMask::from_states(&[2, 8]).unwrap()).unwrap();
     for i in 0..4 {
         assert!(t.free().contains(i));
     }
@@ -134,7 +135,7 @@ fn naming_one_quaternion_state_frees_all_four() {
 
 #[test]
 fn a_black_frame_is_lost_and_leaves_a_finite_state() {
-    let mut t = tracker(None).unwrap();
+    let mut t = tracker(FreeMask::all(28)).unwrap();
     let data = vec![0u8; 64 * 48];
     let frame = FrameView::packed(&data, 64, 48).unwrap();
     let report = t.track(&[frame]).unwrap();
@@ -145,7 +146,7 @@ fn a_black_frame_is_lost_and_leaves_a_finite_state() {
 
 #[test]
 fn reset_rejects_a_nan_state_and_keeps_the_old_one() {
-    let mut t = tracker(None).unwrap();
+    let mut t = tracker(FreeMask::all(28)).unwrap();
     let mut bad = initial();
     bad[0] = f32::NAN;
     assert!(t.reset(&bad).is_err());

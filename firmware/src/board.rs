@@ -3,6 +3,7 @@
 use core::convert::Infallible;
 
 use digiteyes_core::camera::Camera;
+use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::measurement::measure_links;
 use digiteyes_core::model::Model;
@@ -367,14 +368,13 @@ where
         if q.len() != model.n_states() || q.iter().any(|v| !v.is_finite()) {
             return Err(Refusal::BadState);
         }
-        if model.n_states() < 32 && free >> model.n_states() != 0 {
-            return Err(Refusal::BadFreeMask);
-        }
-        let list: Vec<u8, 32> = (0..32u8).filter(|&i| free & (1 << i) != 0).collect();
-        Tracker::new(model, &[*camera], q, Some(&list), config).map_err(|e| match e {
+        Tracker::new(model, &[*camera], q, FreeMask(free), config).map_err(|e| match e {
             TrackerError::BadFreeState(_) => Refusal::BadFreeMask,
             TrackerError::Camera(_) | TrackerError::CameraCount => Refusal::BadCamera,
-            _ => Refusal::BadState,
+            TrackerError::State(_) => Refusal::BadState,
+            // Not returned by `Tracker::new` (they are about frames given to `track`); a
+            // state the tracker cannot start from is the nearest refusal.
+            TrackerError::FrameCount | TrackerError::Frame(_) => Refusal::BadState,
         })
     }
 
@@ -524,15 +524,7 @@ where
     }
 
     fn report_drop(&mut self, dropped: Dropped) -> Result<(), S::Error> {
-        let counts = &mut self.stats.dropped;
-        match dropped.reason {
-            DropReason::Incomplete => counts.incomplete += 1,
-            DropReason::WrongSize(..) => counts.wrong_size += 1,
-            DropReason::TooLarge => counts.too_large += 1,
-            DropReason::NotReady => counts.not_ready += 1,
-            DropReason::Superseded => counts.superseded += 1,
-            DropReason::TrackerError => counts.tracker_error += 1,
-        }
+        self.stats.dropped.record(&dropped.reason);
         if matches!(
             dropped.reason,
             DropReason::WrongSize(..) | DropReason::TooLarge
@@ -552,7 +544,7 @@ where
             capacities: Capacities {
                 states: model.map_or(0, |m| m.n_states() as u8),
                 max_states: digiteyes_core::config::MAX_STATES as u8,
-                max_frames: digiteyes_core::config::MAX_FRAMES as u8,
+                max_links: digiteyes_core::config::MAX_LINKS as u8,
                 max_frame_bytes: u32::try_from(self.frame.len()).unwrap_or(u32::MAX),
                 max_chunk: MAX_CHUNK as u16,
                 max_message: MAX_MESSAGE as u16,

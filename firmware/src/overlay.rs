@@ -34,16 +34,12 @@ pub fn draw(model: &Model, camera: &Camera, q: &[f32], frame: &[u8], out: &mut [
     view.update(model, &poses, camera, 1.0);
     let mut canvas = Canvas { out, width, height };
     for link in &view.links {
-        let d = link.b - link.a;
-        let len = d.norm();
-        if len < 1e-3 {
+        if link.length() < 1e-3 {
             continue;
         }
-        let normal = Vector2::new(-d.y, d.x) / len;
         canvas.line(link.a, link.b, AXIS_GREY);
-        for (side, sign) in [(0, 1.0), (1, -1.0)] {
-            let a = link.a + normal * (sign * link.r0[side]);
-            let b = link.b + normal * (sign * link.r1[side]);
+        for side in [1, -1] {
+            let (a, b) = link.silhouette(side);
             canvas.line(a, b, EDGE_GREY);
         }
     }

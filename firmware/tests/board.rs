@@ -5,6 +5,7 @@
 mod common;
 
 use common::*;
+use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::model::Model;
 use digiteyes_core::protocol::*;
@@ -102,7 +103,7 @@ fn uploaded_frames_give_the_in_process_trackers_states() {
         model.clone(),
         &[cam],
         &q0,
-        Some(&FREE),
+        FreeMask(free_mask()),
         TrackerConfig::default(),
     )
     .unwrap();

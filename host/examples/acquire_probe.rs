@@ -86,7 +86,7 @@ fn main() -> Result<()> {
             sequence.model.clone(),
             &sequence.cameras,
             &base,
-            sequence.free.as_deref(),
+            sequence.free_mask(),
             TrackerConfig::default(),
             acquire,
         )?;

@@ -16,6 +16,7 @@ use anyhow::{anyhow, Result};
 use digiteyes_core::acquire::{AcquireConfig, Acquirer, Progress, WorkingVolume};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::config::MAX_STATES;
+use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::likelihood::EdgeMap;
 use digiteyes_core::model::Model;
@@ -89,12 +90,12 @@ pub struct AutoTracker {
 
 impl AutoTracker {
     /// A tracker for `model` seen by `cameras`, starting by searching: the states in `free`
-    /// (all when `None`) are searched for, the others kept at `base`.
+    /// are searched for, the others kept at `base`.
     pub fn new(
         model: Model,
         cameras: &[Camera],
         base: &[f32],
-        free: Option<&[u8]>,
+        free: FreeMask,
         config: TrackerConfig,
         acquire: AcquireConfig,
     ) -> Result<Self> {

@@ -293,7 +293,7 @@ mod tests {
             capacities: Capacities {
                 states: 28,
                 max_states: 28,
-                max_frames: 37,
+                max_links: 37,
                 max_frame_bytes: 64,
                 max_chunk: 1024,
                 max_message: 2048,

@@ -29,8 +29,9 @@ use serde::Serialize;
 /// The model frame whose origin gives the pole's height: finger 1's fingertip.
 pub const HEIGHT_TIP: &str = "finger1.tip";
 
-/// States of the pole's base: the palm's world x and y (mm).
-pub const BASE_STATES: [usize; 2] = [4, 5];
+/// States of the pole's base: the palm's world x and y (mm) (not the model's
+/// `model::BASE_STATES`, the count of palm states).
+pub const POLE_BASE_STATES: [usize; 2] = [4, 5];
 
 /// The state driving each button by default: finger 4's abduction (q19) and the thumb's
 /// first trapeziometacarpal joint, its abduction (q24) (rad).
@@ -111,7 +112,7 @@ impl MouseMapper {
             );
         }
         let n = model.n_states();
-        for s in BASE_STATES.iter().chain(&config.button_states) {
+        for s in POLE_BASE_STATES.iter().chain(&config.button_states) {
             if *s >= n {
                 bail!("mouse: the model has {n} states, no q{s}");
             }
@@ -158,8 +159,8 @@ impl MouseMapper {
             };
         }
         Ok(MousePole {
-            x_mm: q[BASE_STATES[0]],
-            y_mm: q[BASE_STATES[1]],
+            x_mm: q[POLE_BASE_STATES[0]],
+            y_mm: q[POLE_BASE_STATES[1]],
             height_mm: (tip_z - self.tip_radius_mm).max(0.0),
             tip_z_mm: tip_z - self.tip_radius_mm,
             buttons: self.pressed,

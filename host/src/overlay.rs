@@ -118,15 +118,11 @@ pub fn draw_overlay(
         canvas.line(w.start, end, colour);
     }
     for link in &projected.links {
-        let d = link.b - link.a;
-        let len = d.norm();
-        if len < 1e-3 {
+        if link.length() < 1e-3 {
             continue;
         }
-        let normal = Vector2::new(-d.y, d.x) / len;
-        for (k, sign) in [(0, 1.0), (1, -1.0)] {
-            let a = link.a + normal * (sign * link.r0[k]);
-            let b = link.b + normal * (sign * link.r1[k]);
+        for side in [1, -1] {
+            let (a, b) = link.silhouette(side);
             canvas.line(a, b, colours::SILHOUETTE);
         }
         canvas.line(link.a, link.b, colours::AXIS);
@@ -455,7 +451,7 @@ mod tests {
                     .iter()
                     .map(|b| (b - e.position).norm())
                     .fold(f32::INFINITY, f32::min);
-                let (_, normal) = digiteyes_core::features::axis_frame(&link.a, &link.b);
+                let normal = link.normal();
                 let axis_point = link.a + (link.b - link.a) * e.s;
                 let across = (e.position - axis_point).dot(&normal) * f32::from(e.side);
                 let to_outline = (across - link.side_radius_at(e.s, e.side)).abs();

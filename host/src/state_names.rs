@@ -4,6 +4,8 @@
 //! (w, x, y, z), q4..q6 its translation (mm, world), then four joints per finger (abduction,
 //! MCP, PIP and DIP flexion; rad) and five for the thumb (q23..q27, rad).
 
+use digiteyes_core::state::StateKind;
+
 /// States of the whole-hand model.
 pub const HAND_STATES: usize = 28;
 
@@ -37,10 +39,10 @@ pub fn state_meaning(i: usize) -> String {
 
 /// The unit of state `i`: "" for the quaternion, "mm" for the translation, "rad" for joints.
 pub fn state_unit(i: usize) -> &'static str {
-    match i {
-        0..=3 => "",
-        4..=6 => "mm",
-        _ => "rad",
+    match StateKind::of(i) {
+        StateKind::Quaternion => "",
+        StateKind::Translation => "mm",
+        StateKind::Joint => "rad",
     }
 }
 

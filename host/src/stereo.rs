@@ -375,7 +375,7 @@ pub fn stream_stereo(seq: &Path, out_csv: &Path, options: &StereoOptions) -> Res
                 port: port.clone(),
                 ..BoardFigures::default()
             },
-            links: vec![None; digiteyes_core::config::MAX_FRAMES],
+            links: vec![None; digiteyes_core::config::MAX_LINKS],
             silhouette: None,
             awaiting: false,
             answered_this_frame: false,

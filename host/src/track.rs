@@ -96,7 +96,7 @@ pub fn sequence_tracker(
         sequence.model.clone(),
         &sequence.cameras,
         &initial,
-        sequence.free.as_deref(),
+        sequence.free_mask(),
         config,
     )
 }

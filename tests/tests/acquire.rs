@@ -84,7 +84,7 @@ fn hand_free_frames_are_never_claimed() {
         sequence.model.clone(),
         &sequence.cameras,
         &base,
-        None,
+        digiteyes_core::estimator::FreeMask::all(sequence.n_states()),
         TrackerConfig::default(),
         acquire,
     )

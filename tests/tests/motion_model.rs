@@ -7,6 +7,7 @@ mod common;
 use std::path::Path;
 
 use digiteyes_core::camera::Camera;
+use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::{Model, Shape};
@@ -42,7 +43,7 @@ fn tracker(seq: &Sequence, config: TrackerConfig) -> Tracker {
         seq.model.clone(),
         &seq.cameras,
         &initial,
-        seq.free.as_deref(),
+        seq.free_mask(),
         config,
     )
     .unwrap()
@@ -194,7 +195,14 @@ fn a_finger_seen_end_on_keeps_its_joints() {
     };
     let renderer = Renderer::new(&model, &camera, settings);
     let run = |config: TrackerConfig| -> f32 {
-        let mut t = Tracker::new(model.clone(), &[camera], &q, None, config).unwrap();
+        let mut t = Tracker::new(
+            model.clone(),
+            &[camera],
+            &q,
+            FreeMask::all(model.n_states()),
+            config,
+        )
+        .unwrap();
         let mut worst = 0.0f32;
         for k in 0..30 {
             // The other fingers flex and the palm sways; finger 2 holds still.

@@ -8,7 +8,7 @@ use heapless::{String, Vec};
 use serde::{Deserialize, Serialize};
 
 use super::params::{CameraParams, TrackerParams};
-use crate::config::{MAX_FRAMES, MAX_STATES};
+use crate::config::{MAX_LINKS, MAX_STATES};
 use crate::features::MAX_LINK_EDGES;
 
 /// Longest board name in [`Hello`] (bytes of UTF-8).
@@ -104,8 +104,9 @@ pub struct Capacities {
     pub states: u8,
     /// Most states a message can carry ([`MAX_STATES`]).
     pub max_states: u8,
-    /// Most model frames ([`MAX_FRAMES`]).
-    pub max_frames: u8,
+    /// Most model links, the rows of a model ([`MAX_LINKS`]). Was `max_frames`: the same
+    /// position in the encoding, so the rename changed no byte.
+    pub max_links: u8,
     /// Largest frame the board's buffer holds (bytes = width × height).
     pub max_frame_bytes: u32,
     /// Largest `FrameChunk` payload (bytes).
@@ -183,7 +184,7 @@ pub struct Features {
     /// The camera (its index on the host; a board tracks one camera).
     pub camera: u8,
     /// One entry per link that was measured.
-    pub links: Vec<LinkMeasurement, MAX_FRAMES>,
+    pub links: Vec<LinkMeasurement, MAX_LINKS>,
 }
 
 /// Frames that were not tracked, by reason.
@@ -202,6 +203,35 @@ pub struct DropCounts {
     pub superseded: u32,
     /// The tracker refused the frame.
     pub tracker_error: u32,
+}
+
+impl DropCounts {
+    /// Counts one frame dropped for `reason` (saturating).
+    pub fn record(&mut self, reason: &DropReason) {
+        let counter = match reason {
+            DropReason::Incomplete => &mut self.incomplete,
+            DropReason::WrongSize(..) => &mut self.wrong_size,
+            DropReason::TooLarge => &mut self.too_large,
+            DropReason::NotReady => &mut self.not_ready,
+            DropReason::Superseded => &mut self.superseded,
+            DropReason::TrackerError => &mut self.tracker_error,
+        };
+        *counter = counter.saturating_add(1);
+    }
+
+    /// Frames dropped for any reason (saturating).
+    pub fn total(&self) -> u32 {
+        [
+            self.incomplete,
+            self.wrong_size,
+            self.too_large,
+            self.not_ready,
+            self.superseded,
+            self.tracker_error,
+        ]
+        .iter()
+        .fold(0u32, |sum, n| sum.saturating_add(*n))
+    }
 }
 
 /// Link error counters of one receiver.

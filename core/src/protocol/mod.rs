@@ -35,7 +35,7 @@ pub const MAX_CHUNK: usize = 1024;
 /// Largest encoded message either side sends or accepts (bytes, both zero delimiters
 /// included: at most `MAX_MESSAGE − 2` COBS bytes between them), so the size of every receive
 /// and transmit buffer: the largest are a `Features` naming all
-/// [`MAX_FRAMES`](crate::config::MAX_FRAMES) links (1,315 bytes) and a full `FrameChunk`
+/// [`MAX_LINKS`](crate::config::MAX_LINKS) links (1,315 bytes) and a full `FrameChunk`
 /// (about 1,050 bytes); `tests/protocol.rs` checks both fit.
 pub const MAX_MESSAGE: usize = 1408;
 

@@ -105,7 +105,7 @@ impl Case {
             self.model().clone(),
             self.cameras(),
             &self.initial,
-            self.sequence.free.as_deref(),
+            self.sequence.free_mask(),
             config,
         )
         .map_err(|e| anyhow!("cannot start the tracker: {e}"))

@@ -10,6 +10,7 @@ use std::sync::Mutex;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use digiteyes_core::motion::MotionConfig;
+use digiteyes_core::state::TRANSLATION;
 use serde::Serialize;
 
 use crate::eval::{evaluate, stats};
@@ -175,7 +176,7 @@ pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResu
         iterations_per_frame: stats::mean(&iterations),
     };
     for (k, (estimate, true_state)) in table.table.rows.iter().zip(&truth.rows).enumerate() {
-        let palm_mm = (4..7)
+        let palm_mm = TRANSLATION
             .map(|i| (estimate[i] - true_state[i]).powi(2))
             .sum::<f64>()
             .sqrt();

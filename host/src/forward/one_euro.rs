@@ -11,6 +11,7 @@
 //! translation (mm) and the angles (rad) have one each ([`Smoothing`]).
 
 use anyhow::{bail, Result};
+use digiteyes_core::state::TRANSLATION;
 
 /// Default lowest cutoff, at rest (Hz).
 pub const DEFAULT_MIN_CUTOFF_HZ: f32 = 1.0;
@@ -184,7 +185,7 @@ impl Smoothing {
 
     /// The filter parameters of state `i` (q4..q6 in mm, the rest in rad or quaternion units).
     pub fn for_state(&self, i: usize) -> OneEuroConfig {
-        let beta = if (4..7).contains(&i) {
+        let beta = if TRANSLATION.contains(&i) {
             self.beta_mm
         } else {
             self.beta_rad

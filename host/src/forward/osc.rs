@@ -85,17 +85,7 @@ pub fn dropped_message(dropped: &Dropped) -> OscPacket {
 /// crc_errors framing_errors` (dropped: every reason together; the CRC and framing errors of
 /// the board's receiver).
 pub fn stats_message(stats: &Stats) -> OscPacket {
-    let d = &stats.dropped;
-    let dropped = [
-        d.incomplete,
-        d.wrong_size,
-        d.too_large,
-        d.not_ready,
-        d.superseded,
-        d.tracker_error,
-    ]
-    .iter()
-    .fold(0u32, |sum, n| sum.saturating_add(*n));
+    let dropped = stats.dropped.total();
     message(
         STATS,
         [

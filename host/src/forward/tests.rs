@@ -124,7 +124,7 @@ fn hello(model_digest: u32, clock_hz: u32) -> Hello {
         capacities: Capacities {
             states: 28,
             max_states: 28,
-            max_frames: 37,
+            max_links: 37,
             max_frame_bytes: 640 * 480,
             max_chunk: 1024,
             max_message: 2048,

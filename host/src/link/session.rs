@@ -13,7 +13,7 @@
 
 use std::io::Write;
 use std::path::Path;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use anyhow::{bail, Result};
 use digiteyes_core::config::MAX_STATES;
@@ -387,20 +387,12 @@ fn placeholder_hello() -> Hello {
         capacities: digiteyes_core::protocol::Capacities {
             states: 0,
             max_states: 0,
-            max_frames: 0,
+            max_links: 0,
             max_frame_bytes: 0,
             max_chunk: 0,
             max_message: 0,
         },
     }
-}
-
-/// The reply timeout as a [`Duration`] from seconds (`--reply-timeout`), within the range of
-/// [`crate::cli_values::positive_seconds`].
-pub fn reply_timeout(seconds: f64) -> Result<Duration> {
-    crate::cli_values::positive_seconds(&seconds.to_string())
-        .map_err(|e| anyhow::anyhow!("--reply-timeout: {e}"))?;
-    Ok(crate::cli_values::duration(seconds))
 }
 
 /// A board set up from a sequence description, with the link handed back for listening.

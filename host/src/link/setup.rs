@@ -66,10 +66,7 @@ impl SessionSetup {
         if n > 32 {
             bail!("the model has {n} states; the link carries at most 32");
         }
-        let free = sequence
-            .free_states()
-            .iter()
-            .fold(0u32, |mask, &s| mask | (1 << s));
+        let free = sequence.free_mask().0;
         Ok(SessionSetup {
             camera,
             tracker: TrackerParams::default(),

@@ -12,7 +12,7 @@ use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use super::input::Inputs;
 use super::plots::{decorate, entry, estimate_plot, new_chart};
 use crate::mouse_pole::accuracy::{compare, poles, MouseAccuracy, BUTTON_NAMES};
-use crate::mouse_pole::{MouseConfig, MousePole, BASE_STATES};
+use crate::mouse_pole::{MouseConfig, MousePole, POLE_BASE_STATES};
 
 /// The palm's height above the table (world z, q6): fixed in a 3D-mouse sub-model.
 const PALM_HEIGHT_STATE: usize = 6;
@@ -36,7 +36,7 @@ pub struct MouseSection {
 /// Whether a sequence estimating `free` drives the thesis' 3D mouse: the palm slides on the
 /// table (its x and y free, its height fixed) and finger 1 lifts the pole (its MCP free).
 pub fn is_mouse_sub_model(free: &[usize]) -> bool {
-    BASE_STATES.iter().all(|s| free.contains(s))
+    POLE_BASE_STATES.iter().all(|s| free.contains(s))
         && free.contains(&FINGER1_MCP_STATE)
         && !free.contains(&PALM_HEIGHT_STATE)
 }

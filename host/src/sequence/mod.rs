@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, ensure, Context, Result};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::config::MAX_CAMERAS;
+use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Model;
 use image::GrayImage;
@@ -101,6 +102,17 @@ impl Sequence {
         match &self.free {
             Some(list) => list.iter().map(|&s| usize::from(s)).collect(),
             None => (0..self.n_states()).collect(),
+        }
+    }
+
+    /// The states the tracker estimates as a mask (all when `free` is absent). `open` checked
+    /// every listed state is one of the model's (fewer than 32).
+    pub fn free_mask(&self) -> FreeMask {
+        match &self.free {
+            Some(list) => list
+                .iter()
+                .fold(FreeMask(0), |m, &s| FreeMask(m.0 | 1 << s)),
+            None => FreeMask::all(self.n_states()),
         }
     }
 

@@ -8,7 +8,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use digiteyes_core::quaternion;
+use digiteyes_core::state::renormalise_quaternion;
 use digiteyes_core::tracker::FrameReport;
 
 /// The report columns the tracker's output adds after the states.
@@ -259,11 +259,7 @@ impl StatesWriter {
             );
         }
         let mut state = state.to_vec();
-        if state.len() >= 4 {
-            if let Some(q) = quaternion::normalised([state[0], state[1], state[2], state[3]]) {
-                state[..4].copy_from_slice(&q);
-            }
-        }
+        renormalise_quaternion(&mut state);
         let mut line = self.frames.to_string();
         for v in &state {
             line.push_str(&format!(",{v}"));

@@ -1,0 +1,154 @@
+//! The estimator's parameters: residual kind, robust weight, conditioning, free states.
+
+use crate::state::{StateKind, QUATERNION_BITS};
+
+/// Which residuals a link's edge points give.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ResidualKind {
+    /// One row per edge point: its distance from the predicted silhouette line.
+    EdgePoints,
+    /// Two rows per link: the model axis' end points against the fitted axis line (Eq. 2.17).
+    AxisLines,
+    /// One row per slice: where both edges were found, the distance of their midpoint from the
+    /// model axis (blind to a width bias, such as shading pulling both edges inward); a lone
+    /// edge gives its edge-point row.
+    AxisPoints,
+}
+
+/// Robust weighting of residuals (px).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Robust {
+    /// Plain least squares.
+    None,
+    /// Huber: weight 1 up to `k` px, then `k / |r|`.
+    Huber(f32),
+    /// Tukey's biweight: `(1 − (r/c)²)²` up to `c` px, 0 beyond.
+    Tukey(f32),
+}
+
+impl Robust {
+    /// The weight of a residual `r` (px).
+    #[inline]
+    pub fn weight(&self, r: f32) -> f32 {
+        let a = r.abs();
+        match *self {
+            Robust::None => 1.0,
+            Robust::Huber(k) if a > k => k / a,
+            Robust::Huber(_) => 1.0,
+            Robust::Tukey(c) if a < c => {
+                let u = 1.0 - (r / c) * (r / c);
+                u * u
+            }
+            Robust::Tukey(_) => 0.0,
+        }
+    }
+}
+
+/// The diagonal of the conditioning matrix `S` per kind of state (Table 4.2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Conditioning {
+    /// For each quaternion state.
+    pub quaternion: f32,
+    /// For each translation state (per mm²).
+    pub translation: f32,
+    /// For each joint angle (per rad²).
+    pub joint: f32,
+}
+
+impl Conditioning {
+    /// The thesis' weights (Table 4.2): quaternion 1, translation 10, joint 1000.
+    pub const THESIS: Conditioning = Conditioning {
+        quaternion: 1.0,
+        translation: 10.0,
+        joint: 1000.0,
+    };
+
+    /// `S` for state `i`.
+    #[inline]
+    pub fn for_state(&self, i: usize) -> f32 {
+        StateKind::of(i).pick(self.quaternion, self.translation, self.joint)
+    }
+}
+
+/// Parameters of the estimator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub struct EstimatorConfig {
+    /// Which residuals edges give.
+    pub residual: ResidualKind,
+    /// Robust weighting of edge and tip residuals.
+    pub robust: Robust,
+    /// The conditioning matrix `S`.
+    pub conditioning: Conditioning,
+    /// Weight of a tip row relative to an edge row.
+    pub tip_weight: f32,
+}
+
+impl Default for EstimatorConfig {
+    fn default() -> Self {
+        EstimatorConfig {
+            residual: ResidualKind::AxisPoints,
+            robust: Robust::Huber(2.0),
+            conditioning: Conditioning {
+                quaternion: 1.0,
+                translation: 1.0,
+                joint: 1000.0,
+            },
+            tip_weight: 1.0,
+        }
+    }
+}
+
+/// Which states the estimator may change: bit `i` for state `qi`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FreeMask(pub u32);
+
+impl FreeMask {
+    /// Every state of a model with `n` states.
+    pub fn all(n: usize) -> Self {
+        FreeMask(if n >= 32 { u32::MAX } else { (1u32 << n) - 1 })
+    }
+
+    /// The states listed, or the first listed that no mask can hold (32 or more).
+    pub fn from_states(states: &[u8]) -> Result<Self, u8> {
+        let mut mask = 0u32;
+        for &s in states {
+            mask |= 1u32.checked_shl(u32::from(s)).ok_or(s)?;
+        }
+        Ok(FreeMask(mask))
+    }
+
+    /// The same states with the whole quaternion free if any of its components is: its four
+    /// components move together (a step renormalises them).
+    #[inline]
+    pub fn with_whole_quaternion(self) -> Self {
+        if self.0 & QUATERNION_BITS != 0 {
+            FreeMask(self.0 | QUATERNION_BITS)
+        } else {
+            self
+        }
+    }
+
+    /// The first state named that a model with `n` states does not have, if any.
+    #[inline]
+    pub fn first_beyond(&self, n: usize) -> Option<u8> {
+        let beyond = if n >= 32 { 0 } else { self.0 >> n };
+        (beyond != 0).then(|| (n as u32 + beyond.trailing_zeros()) as u8)
+    }
+
+    /// Whether state `i` is free.
+    #[inline]
+    pub fn contains(&self, i: usize) -> bool {
+        i < 32 && self.0 & (1 << i) != 0
+    }
+
+    /// Number of free states.
+    pub fn count(&self) -> u32 {
+        self.0.count_ones()
+    }
+}
