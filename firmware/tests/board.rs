@@ -39,15 +39,7 @@ fn reset(q: &[f32]) -> HostMessage<'static> {
 
 /// A board after boot, Configure and Reset, with the replies checked.
 fn ready_board<'m>(buffer: &'m mut [u8], q0: &[f32]) -> Board<'m, Pipe, Uploads, NoLed, StepClock> {
-    let mut board = Board::new(
-        "test",
-        buffer,
-        None,
-        Pipe::default(),
-        Uploads,
-        NoLed,
-        StepClock(0),
-    );
+    let mut board = test_board("test", buffer);
     board.start().unwrap();
     board.serial_mut().send(&configure(0, 0));
     board.serial_mut().send(&reset(q0));
@@ -71,15 +63,7 @@ fn ready_board<'m>(buffer: &'m mut [u8], q0: &[f32]) -> Board<'m, Pipe, Uploads,
 #[test]
 fn hello_names_the_board_and_its_model() {
     let mut buffer = vec![0u8; FRAME_BYTES];
-    let mut board = Board::new(
-        "qemu-m7",
-        &mut buffer,
-        None,
-        Pipe::default(),
-        Uploads,
-        NoLed,
-        StepClock(0),
-    );
+    let mut board = test_board("qemu-m7", &mut buffer);
     board.start().unwrap();
     let [BoardMessage::Hello(hello)] = &board.serial_mut().received()[..] else {
         panic!("one Hello at boot");
@@ -306,15 +290,7 @@ fn a_chunk_past_the_frames_end_is_too_large() {
 #[test]
 fn frames_before_configure_and_reset_are_not_ready() {
     let mut buffer = vec![0u8; FRAME_BYTES];
-    let mut board = Board::new(
-        "t",
-        &mut buffer,
-        None,
-        Pipe::default(),
-        Uploads,
-        NoLed,
-        StepClock(0),
-    );
+    let mut board = test_board("t", &mut buffer);
     board
         .serial_mut()
         .send_frame(1, WIDTH as u16, HEIGHT as u16, &vec![0u8; FRAME_BYTES]);
@@ -346,15 +322,7 @@ fn bad_commands_are_refused_and_change_nothing() {
     let model = Model::hand().unwrap();
     let q0 = pose(&model, 0.2);
     let mut buffer = vec![0u8; FRAME_BYTES];
-    let mut board = Board::new(
-        "t",
-        &mut buffer,
-        None,
-        Pipe::default(),
-        Uploads,
-        NoLed,
-        StepClock(0),
-    );
+    let mut board = test_board("t", &mut buffer);
     let pipe = board.serial_mut();
     pipe.send(&reset(&q0));
     let mut cam = CameraParams::from_camera(&camera()).unwrap();
@@ -494,15 +462,7 @@ fn features_are_sent_every_n_frames_and_name_links_in_view() {
     let q0 = pose(&model, 0.2);
     let pixels = render(&model, &cam, &q0);
     let mut buffer = vec![0u8; FRAME_BYTES];
-    let mut board = Board::new(
-        "t",
-        &mut buffer,
-        None,
-        Pipe::default(),
-        Uploads,
-        NoLed,
-        StepClock(0),
-    );
+    let mut board = test_board("t", &mut buffer);
     board.serial_mut().send(&configure(0, 2));
     board.serial_mut().send(&reset(&q0));
     for n in 0..4 {

@@ -19,15 +19,7 @@ use digiteyes_firmware::{Board, NoLed, Uploads};
 const FRAME_BYTES: usize = (WIDTH * HEIGHT) as usize;
 
 fn board(buffer: &mut [u8]) -> Board<'_, Pipe, Uploads, NoLed, StepClock> {
-    let mut board = Board::new(
-        "test",
-        buffer,
-        None,
-        Pipe::default(),
-        Uploads,
-        NoLed,
-        StepClock(0),
-    );
+    let mut board = test_board("test", buffer);
     board.start().unwrap();
     board.serial_mut().received();
     board

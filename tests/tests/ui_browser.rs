@@ -10,8 +10,7 @@ mod common;
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream, UdpSocket};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -24,29 +23,6 @@ use digiteyes_host::{track_sequence, TrackerConfig};
 /// The 3D canvas's background (`#e9edf2` in style.css and app.js).
 const CANVAS_BACKGROUND: [u8; 3] = [0xe9, 0xed, 0xf2];
 
-/// The browser, or why the test is skipped.
-fn chromium() -> Result<PathBuf, String> {
-    let candidates: Vec<PathBuf> = match std::env::var_os("DIGITEYES_CHROMIUM") {
-        Some(path) => vec![PathBuf::from(path)],
-        None => ["chromium", "chromium-browser", "google-chrome"]
-            .iter()
-            .map(PathBuf::from)
-            .collect(),
-    };
-    for exe in candidates {
-        let works = Command::new(&exe)
-            .arg("--version")
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .status()
-            .is_ok_and(|s| s.success());
-        if works {
-            return Ok(exe);
-        }
-    }
-    Err("no chromium found (apt-get install -y chromium, or set DIGITEYES_CHROMIUM)".into())
-}
-
 fn skip(test: &str, reason: &str) {
     common::skip(
         &format!("UI browser test `{test}` (tests/tests/ui_browser.rs)"),
@@ -54,45 +30,21 @@ fn skip(test: &str, reason: &str) {
     );
 }
 
-/// Loads `url` in headless Chromium with a fresh profile, lets the page run for 4 s of its
-/// time, and returns what Chromium printed (the DOM with `--dump-dom`).
-fn chromium_run(exe: &Path, url: &str, extra: &[String]) -> String {
-    let profile = tempfile::tempdir().unwrap();
-    let output = Command::new(exe)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--hide-scrollbars",
-            "--window-size=1340,1100",
-            "--virtual-time-budget=4000",
-        ])
-        .arg(format!("--user-data-dir={}", profile.path().display()))
-        .args(extra)
-        .arg(url)
-        .stdin(Stdio::null())
-        .output()
-        .expect("chromium runs");
-    assert!(
-        output.status.success(),
-        "chromium failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    String::from_utf8_lossy(&output.stdout).into_owned()
-}
+/// How long each page runs (ms of its own time).
+const PAGE_BUDGET_MS: u32 = 4_000;
 
 fn dump_dom(exe: &Path, url: &str) -> String {
-    chromium_run(exe, url, &["--dump-dom".to_string()])
+    common::browser::dump_dom(exe, url, PAGE_BUDGET_MS)
 }
 
 fn screenshot(exe: &Path, url: &str, dir: &Path) -> image::RgbImage {
     let png = dir.join("page.png");
-    chromium_run(exe, url, &[format!("--screenshot={}", png.display())]);
+    common::browser::chromium_run(
+        exe,
+        url,
+        PAGE_BUDGET_MS,
+        &[format!("--screenshot={}", png.display())],
+    );
     image::open(&png).expect("a PNG screenshot").to_rgb8()
 }
 
@@ -214,7 +166,7 @@ impl Drop for Streamer {
 
 #[test]
 fn streamed_states_show_in_the_page_and_draw_a_hand() {
-    let exe = match chromium() {
+    let exe = match common::browser::chromium() {
         Ok(exe) => exe,
         Err(reason) => return skip("streamed states", &reason),
     };
@@ -278,7 +230,7 @@ fn streamed_states_show_in_the_page_and_draw_a_hand() {
 
 #[test]
 fn a_replay_shows_the_camera_frame_with_the_model() {
-    let exe = match chromium() {
+    let exe = match common::browser::chromium() {
         Ok(exe) => exe,
         Err(reason) => return skip("replay", &reason),
     };

@@ -12,7 +12,6 @@ mod common;
 
 use std::net::{SocketAddr, UdpSocket};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -32,61 +31,6 @@ const STEP_DEADLINE: Duration = Duration::from_secs(10);
 /// Polls the page must make after the hub holds a state before the next one is sent: the
 /// first may have been answered from the previous state, the second cannot have been.
 const POLLS_PER_STEP: u64 = 2;
-
-/// The browser, or why the test is skipped.
-fn chromium() -> Result<PathBuf, String> {
-    let candidates: Vec<PathBuf> = match std::env::var_os("DIGITEYES_CHROMIUM") {
-        Some(path) => vec![PathBuf::from(path)],
-        None => ["chromium", "chromium-browser", "google-chrome"]
-            .iter()
-            .map(PathBuf::from)
-            .collect(),
-    };
-    for exe in candidates {
-        let works = Command::new(&exe)
-            .arg("--version")
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .status()
-            .is_ok_and(|s| s.success());
-        if works {
-            return Ok(exe);
-        }
-    }
-    Err("no chromium found (apt-get install -y chromium, or set DIGITEYES_CHROMIUM)".into())
-}
-
-/// Loads `url` in headless Chromium with a fresh profile, lets the page run for
-/// `budget_ms` of its (virtual) time, and returns the DOM it ends with.
-fn dump_dom(exe: &Path, url: &str, budget_ms: u32) -> String {
-    let profile = tempfile::tempdir().unwrap();
-    let output = Command::new(exe)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--hide-scrollbars",
-            "--window-size=1340,1100",
-            "--dump-dom",
-        ])
-        .arg(format!("--virtual-time-budget={budget_ms}"))
-        .arg(format!("--user-data-dir={}", profile.path().display()))
-        .arg(url)
-        .stdin(Stdio::null())
-        .output()
-        .expect("chromium runs");
-    assert!(
-        output.status.success(),
-        "chromium failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    String::from_utf8_lossy(&output.stdout).into_owned()
-}
 
 /// The value of `data-NAME` on the page's `<body>`.
 fn body_data<'a>(dom: &'a str, name: &str) -> &'a str {
@@ -226,7 +170,7 @@ fn run_page(exe: &Path, first: &[f32], script: Vec<Vec<f32>>) -> String {
     let steps = script.len();
     let player = Player::start(Arc::clone(ui.hub()), to, script);
     let started = Instant::now();
-    let dom = dump_dom(exe, &ui.url(), PAGE_BUDGET_MS);
+    let dom = common::browser::dump_dom(exe, &ui.url(), PAGE_BUDGET_MS);
     println!("the page ran {:.1} s", started.elapsed().as_secs_f64());
     let seen = player.finish();
     ui.stop().unwrap();
@@ -252,7 +196,7 @@ const FINGER4: usize = 19;
 const PALM_X: usize = 4;
 
 fn chromium_or_skip(test: &str) -> Option<PathBuf> {
-    match chromium() {
+    match common::browser::chromium() {
         Ok(exe) => Some(exe),
         Err(reason) => {
             common::skip(

@@ -13,7 +13,7 @@ use digiteyes_core::projection::ProjectedModel;
 use digiteyes_core::protocol::{
     encode, BoardMessage, Decoder, FrameChunk, HostMessage, MAX_CHUNK, MAX_MESSAGE,
 };
-use digiteyes_firmware::{Clock, FrameSource, SourceError};
+use digiteyes_firmware::{Board, Clock, FrameSource, NoLed, SourceError, Uploads};
 
 pub const WIDTH: u32 = 160;
 pub const HEIGHT: u32 = 120;
@@ -185,4 +185,20 @@ pub fn render(model: &Model, camera: &Camera, q: &[f32]) -> Vec<u8> {
         }
     }
     img
+}
+
+/// A board on the in-memory port, taking uploaded frames, with a step clock.
+pub type TestBoard<'m> = Board<'m, Pipe, Uploads, NoLed, StepClock>;
+
+/// A [`TestBoard`] named `name` with frame buffer `buffer` (not yet started).
+pub fn test_board<'m>(name: &'static str, buffer: &'m mut [u8]) -> TestBoard<'m> {
+    Board::new(
+        name,
+        buffer,
+        None,
+        Pipe::default(),
+        Uploads,
+        NoLed,
+        StepClock(0),
+    )
 }
