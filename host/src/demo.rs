@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{Context, Result};
-use digiteyes_board_linux::{SimOptions, SimReport};
+use crate::sim::{SimOptions, SimReport};
 use digiteyes_core::protocol::TrackerParams;
 
 use crate::eval::{evaluate, EvalReport};

@@ -13,7 +13,8 @@
 //! - [`listen`]: a board's messages printed and forwarded as JSON lines over UDP.
 //! - [`forward`]: `listen --forward`: JSON lines or Open Sound Control over UDP, optionally
 //!   smoothed by the one-euro filter.
-//! - [`sim`]: the simulated Linux board on a pseudo-terminal.
+//! - [`sim`]: the simulated board (the firmware loop on a pseudo-terminal, on the Linux
+//!   platform), its line noise, frame tap, overlays and UI feed.
 //! - [`overlay`]: the debug overlay (model, slices, edges, tips over a frame) as RGB images.
 //! - [`state_names`]: what each state means, for labels.
 //! - [`report`]: a run as one self-contained HTML page: each free state against time, the

@@ -1,6 +1,5 @@
 //! `digiteyes`: render, track and evaluate hand sequences. A thin layer over the library.
 
-use digiteyes_board_linux::parse_frame_size;
 use std::io::IsTerminal;
 use std::net::SocketAddr;
 use std::ops::Range;
@@ -9,7 +8,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Result};
 use clap::{Args, Parser, Subcommand};
-use digiteyes_board_linux::SimOptions;
+use digiteyes_platform_linux::parse_frame_size;
 use digiteyes_core::protocol::TrackerParams;
 use digiteyes_host::cli_values;
 use digiteyes_host::demo::{
@@ -25,7 +24,8 @@ use digiteyes_host::scenarios::{
 };
 use digiteyes_host::stereo::{stream_stereo, StereoOptions};
 use digiteyes_host::stream::{stream_camera, DEFAULT_BAUD};
-use digiteyes_host::ui::board_tap::ui_tap;
+use digiteyes_host::sim::ui_tap::ui_tap;
+use digiteyes_host::sim::SimOptions;
 use digiteyes_host::ui::{attach_mouse, run_ui, Hub, UiOptions, UiServer, UiSource, DEFAULT_BIND};
 use digiteyes_host::{
     evaluate, stream_sequence, track_sequence_with, StreamOptions, TrackerConfig,

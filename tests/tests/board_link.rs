@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::time::Duration;
 
-use digiteyes_board_linux::{Corruption, SimBoard, SimOptions, SimReport, Window};
+use digiteyes_host::sim::{Corruption, SimBoard, SimOptions, SimReport, Window};
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::protocol::DropReason;
 use digiteyes_host::link::{DropCause, FrameOutcome, Link, Session, SessionSetup};

@@ -3,7 +3,8 @@
 
 use std::mem::size_of;
 
-use digiteyes_board_linux::{MonotonicClock, Source, StatusLed, TtySerial};
+use digiteyes_board_linux::{Source, StatusLed};
+use digiteyes_platform_linux::{MonotonicClock, TtySerial};
 use digiteyes_core::protocol::{Decoder, MAX_MESSAGE};
 use digiteyes_core::tracker::Tracker;
 use digiteyes_firmware::Board;

@@ -4,7 +4,7 @@ use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Context, Result};
-use digiteyes_board_linux::TtySerial;
+use digiteyes_platform_linux::TtySerial;
 use digiteyes_core::protocol::{
     encode, BoardMessage, Decoder, HostMessage, LinkCounters, MAX_MESSAGE,
 };

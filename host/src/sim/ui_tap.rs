@@ -7,10 +7,10 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 
 use anyhow::{Context, Result};
-use digiteyes_board_linux::{FrameTap, SimFrame};
+use super::{FrameTap, SimFrame};
 use image::GrayImage;
 
-use super::hub::{CameraFrame, Hub, ShownState};
+use crate::ui::hub::{CameraFrame, Hub, ShownState};
 
 /// Frames waiting for the UI before the board skips handing it more (a live view needs the
 /// newest frame, not every one; the board never waits for the UI).
