@@ -1,6 +1,7 @@
 //! The host side of digiteyes: sequence I/O, the synthetic renderer, tracking and evaluation
 //! of recorded sequences. The `digiteyes` binary is a thin command-line layer over this crate.
 //!
+//! - [`cli`]: the `digiteyes` command line, one module per command (its options, its `run`).
 //! - [`sequence`]: the on-disk contract of `docs/sequence-format.md` — `sequence.json`, the
 //!   `camN/NNNNNN.pgm` frames, `truth.csv` and the tracker's output CSV.
 //! - [`render`]: the project's synthetic renderer (ray-cast capsules and the palm box,
@@ -33,6 +34,7 @@
 
 pub mod atomic_file;
 pub mod bench;
+pub mod cli;
 pub mod cli_values;
 pub mod demo;
 pub mod eval;

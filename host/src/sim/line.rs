@@ -14,8 +14,8 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use digiteyes_core::protocol::{Decoder, HostMessage, MAX_MESSAGE};
-use embedded_io::{Read, ReadReady};
 use digiteyes_platform_linux::TtySerial;
+use embedded_io::{Read, ReadReady};
 
 use super::fault_injector::UploadedFrame;
 use super::{Deafness, SimReport};

@@ -24,7 +24,6 @@ pub mod ui_tap;
 use std::cell::RefCell;
 use std::fmt;
 use std::io;
-use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -32,7 +31,7 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-use anyhow::{bail, Context, Result};
+use anyhow::Context;
 use digiteyes_core::protocol::Stats;
 use digiteyes_firmware::{Board, NoLed, Tracked, Uploads};
 use digiteyes_platform_linux::{MonotonicClock, TtySerial};
@@ -349,59 +348,3 @@ fn run(
 pub fn start(options: SimOptions) -> anyhow::Result<SimBoard> {
     SimBoard::start(options).context("cannot start the simulated board on a pseudo-terminal")
 }
-
-/// Line noise from the command line: `rate` of the bytes, in `frames` (all when `None`).
-pub fn corruption(rate: f64, frames: Option<Range<u32>>, seed: u64) -> Result<Corruption> {
-    if !(0.0..=1.0).contains(&rate) {
-        bail!("--corrupt {rate}: the rate is a fraction of the bytes, 0 to 1 (0.01 = 1%)");
-    }
-    Ok(Corruption {
-        rate,
-        window: frames.map_or(Window::Always, Window::Frames),
-        seed,
-    })
-}
-
-/// Parses `A..B` (frames A to B-1).
-pub fn parse_range(text: &str) -> Result<Range<u32>, String> {
-    let (a, b) = text
-        .split_once("..")
-        .ok_or_else(|| format!("`{text}` is not a range A..B, e.g. 10..20"))?;
-    let parse = |s: &str| {
-        s.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("`{s}` is not a frame number"))
-    };
-    let (a, b) = (parse(a)?, parse(b)?);
-    if a >= b {
-        return Err(format!("`{text}` is empty: A must be below B"));
-    }
-    Ok(a..b)
-}
-
-/// Runs `boards` until the process is interrupted (or one stops), printing each line's
-/// figures every `every` (never when `None`).
-pub fn serve(boards: Vec<SimBoard>, every: Option<Duration>) -> Result<()> {
-    // How often a quiet server looks whether every board still runs.
-    const CHECK: Duration = Duration::from_millis(200);
-    let mut since_report = Duration::ZERO;
-    loop {
-        std::thread::sleep(CHECK);
-        if let Some(stopped) = boards.iter().position(|b| !b.is_running()) {
-            let mut boards = boards;
-            boards
-                .swap_remove(stopped)
-                .wait()
-                .context("a simulated board stopped")?;
-            return Ok(());
-        }
-        since_report += CHECK;
-        if every.is_some_and(|e| since_report >= e) {
-            since_report = Duration::ZERO;
-            for b in &boards {
-                eprintln!("{}: {}", b.path().display(), b.report());
-            }
-        }
-    }
-}
-

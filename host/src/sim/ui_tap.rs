@@ -6,8 +6,8 @@ use std::sync::mpsc::{sync_channel, Receiver};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 
-use anyhow::{Context, Result};
 use super::{FrameTap, SimFrame};
+use anyhow::{Context, Result};
 use image::GrayImage;
 
 use crate::ui::hub::{CameraFrame, Hub, ShownState};
