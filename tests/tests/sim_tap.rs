@@ -7,10 +7,10 @@ use std::path::Path;
 use std::sync::mpsc::sync_channel;
 use std::time::Duration;
 
-use digiteyes_host::sim::{FrameTap, SimBoard, SimFrame, SimOptions, SimReport, TapMode};
 use digiteyes_host::link::FrameOutcome;
 use digiteyes_host::overlay::{colours, overlay_path};
 use digiteyes_host::sequence::Sequence;
+use digiteyes_host::sim::{FrameTap, SimBoard, SimFrame, SimOptions, SimReport, TapMode};
 use digiteyes_host::{stream_sequence, StreamOptions, StreamSummary};
 
 mod common;
