@@ -94,26 +94,27 @@ pub struct PortArgs {
 /// Listens until interrupted, `--states` or `--seconds`; prints the figures on stderr.
 pub fn run(args: ListenArgs) -> Result<()> {
     let port = args.port;
-    let mut options = ListenOptions::default();
-    options.json = args.json;
-    options.forward = args
-        .forward
-        .iter()
-        .map(|url| parse_forward(url))
-        .collect::<Result<_>>()?;
-    options.smoothing = match args.smooth {
-        true => Some(Smoothing::new(
-            args.min_cutoff,
-            args.beta,
-            args.beta_rad,
-            args.d_cutoff,
-        )?),
-        false => None,
+    let options = ListenOptions {
+        json: args.json,
+        forward: args
+            .forward
+            .iter()
+            .map(|url| parse_forward(url))
+            .collect::<Result<_>>()?,
+        smoothing: match args.smooth {
+            true => Some(Smoothing::new(
+                args.min_cutoff,
+                args.beta,
+                args.beta_rad,
+                args.d_cutoff,
+            )?),
+            false => None,
+        },
+        setup: args.setup,
+        camera_index: args.camera_index,
+        states: args.states,
+        duration: args.seconds.map(cli_values::duration),
     };
-    options.setup = args.setup;
-    options.camera_index = args.camera_index;
-    options.states = args.states;
-    options.duration = args.seconds.map(cli_values::duration);
     let link = Link::open(&port.port, port.baud)?;
     eprintln!("listening on {}", port.port);
     let summary = listen(link, &options, &mut std::io::stdout().lock())?;

@@ -44,10 +44,12 @@ pub struct ReportArgs {
 
 /// Writes the report; prints its warnings on stderr and the summary.
 pub fn run(args: ReportArgs) -> Result<()> {
-    let mut options = ReportOptions::default();
-    options.thumb_every = args.thumb_every;
-    options.thumb_width = args.thumb_width;
-    options.camera = args.camera_index;
+    let options = ReportOptions {
+        thumb_every: args.thumb_every,
+        thumb_width: args.thumb_width,
+        camera: args.camera_index,
+        ..ReportOptions::default()
+    };
     let summary = write_report(&args.seqdir, &args.states, &args.out, &options)?;
     for warning in &summary.warnings {
         eprintln!("digiteyes: warning: {warning}");
