@@ -16,8 +16,8 @@ use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use crate::sim::{SimOptions, SimReport};
 use anyhow::{Context, Result};
-use digiteyes_board_linux::{SimOptions, SimReport};
 use digiteyes_core::protocol::TrackerParams;
 
 use crate::eval::{evaluate, EvalReport};

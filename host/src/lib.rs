@@ -1,6 +1,7 @@
 //! The host side of digiteyes: sequence I/O, the synthetic renderer, tracking and evaluation
 //! of recorded sequences. The `digiteyes` binary is a thin command-line layer over this crate.
 //!
+//! - [`cli`]: the `digiteyes` command line, one module per command (its options, its `run`).
 //! - [`sequence`]: the on-disk contract of `docs/sequence-format.md` — `sequence.json`, the
 //!   `camN/NNNNNN.pgm` frames, `truth.csv` and the tracker's output CSV.
 //! - [`render`]: the project's synthetic renderer (ray-cast capsules and the palm box,
@@ -13,7 +14,8 @@
 //! - [`listen`]: a board's messages printed and forwarded as JSON lines over UDP.
 //! - [`forward`]: `listen --forward`: JSON lines or Open Sound Control over UDP, optionally
 //!   smoothed by the one-euro filter.
-//! - [`sim`]: the simulated Linux board on a pseudo-terminal.
+//! - [`sim`]: the simulated board (the firmware loop on a pseudo-terminal, on the Linux
+//!   platform), its line noise, frame tap, overlays and UI feed.
 //! - [`overlay`]: the debug overlay (model, slices, edges, tips over a frame) as RGB images.
 //! - [`state_names`]: what each state means, for labels.
 //! - [`report`]: a run as one self-contained HTML page: each free state against time, the
@@ -33,6 +35,7 @@
 pub mod acquire;
 pub mod atomic_file;
 pub mod bench;
+pub mod cli;
 pub mod cli_values;
 pub mod demo;
 pub mod eval;

@@ -147,12 +147,14 @@ pub fn overlay_path(dir: &Path, cam: usize, frame: usize) -> PathBuf {
         .join(format!("{frame:06}.png"))
 }
 
-/// Overlay PNGs written on a thread of their own, so encoding overlaps the caller's work.
-/// [`PngWriter::write`] waits when `queue` images are pending; the first failure stops the
-/// writer and is returned by the next `write` or by [`PngWriter::finish`].
+/// Overlay PNGs written on a thread of their own, so drawing and encoding overlap the
+/// caller's work: the one background PNG writer (`track --overlay` hands it drawn images,
+/// `sim --overlay` the board's tracked frames to draw, see [`crate::sim::overlay_tap`]).
+/// Senders wait when `queue` jobs are pending; the first write failure stops the writer and is
+/// returned by the next [`PngWriter::write`] or by [`PngWriter::finish`].
 #[derive(Debug)]
-pub struct PngWriter {
-    sender: Option<SyncSender<(PathBuf, RgbImage)>>,
+pub struct PngWriter<J = (PathBuf, RgbImage)> {
+    sender: Option<SyncSender<J>>,
     thread: Option<JoinHandle<Result<PngStats>>>,
 }
 
@@ -161,25 +163,60 @@ pub struct PngWriter {
 pub struct PngStats {
     /// Files written.
     pub files: usize,
-    /// Time spent encoding and writing them, on the writer's thread (s).
+    /// Jobs that gave no image (each reported on stderr by whoever drew it).
+    pub undrawable: usize,
+    /// Time spent drawing, encoding and writing them, on the writer's thread (s).
     pub seconds: f64,
 }
 
 impl PngWriter {
-    /// Starts the writer thread, with room for `queue` pending images (at least 1).
+    /// Starts the writer thread for images drawn by the caller, with room for `queue`
+    /// pending images (at least 1).
     pub fn start(queue: usize) -> Result<Self> {
-        let (sender, receiver) = sync_channel::<(PathBuf, RgbImage)>(queue.max(1));
+        Self::spawn(queue, None, Some)
+    }
+}
+
+impl<J: Send + 'static> PngWriter<J> {
+    /// Starts the writer thread with room for `queue` pending jobs (at least 1): `draw` turns
+    /// each job into the image to write and its path, or `None` when it cannot (having said
+    /// why on stderr). A write failure is also reported on stderr, after `failure` (for a
+    /// writer fed by others, whose failure nobody may ask for until the end).
+    pub fn drawing(
+        queue: usize,
+        failure: &'static str,
+        draw: impl FnMut(J) -> Option<(PathBuf, RgbImage)> + Send + 'static,
+    ) -> Result<Self> {
+        Self::spawn(queue, Some(failure), draw)
+    }
+
+    fn spawn(
+        queue: usize,
+        failure: Option<&'static str>,
+        mut draw: impl FnMut(J) -> Option<(PathBuf, RgbImage)> + Send + 'static,
+    ) -> Result<Self> {
+        let (sender, receiver) = sync_channel::<J>(queue.max(1));
         let thread = std::thread::Builder::new()
             .name("digiteyes-overlay-png".into())
             .spawn(move || {
                 let mut stats = PngStats::default();
                 let mut busy = Duration::ZERO;
                 let mut made: Option<PathBuf> = None;
-                for (path, image) in receiver {
+                for job in receiver {
                     let t0 = Instant::now();
-                    write_png(&path, &image, &mut made)?;
+                    match draw(job) {
+                        Some((path, image)) => {
+                            if let Err(e) = write_png(&path, &image, &mut made) {
+                                if let Some(failure) = failure {
+                                    eprintln!("{failure}: {e:#}");
+                                }
+                                return Err(e);
+                            }
+                            stats.files += 1;
+                        }
+                        None => stats.undrawable += 1,
+                    }
                     busy += t0.elapsed();
-                    stats.files += 1;
                 }
                 stats.seconds = busy.as_secs_f64();
                 Ok(stats)
@@ -191,13 +228,16 @@ impl PngWriter {
         })
     }
 
-    /// Queues `image` to be written to `path` (its folder is created). Fails with the
-    /// writer's error if an earlier write failed.
-    pub fn write(&mut self, path: PathBuf, image: RgbImage) -> Result<()> {
-        let sent = self
-            .sender
-            .as_ref()
-            .is_some_and(|s| s.send((path, image)).is_ok());
+    /// Another way in for jobs (a frame tap's channel), while the writer runs.
+    /// [`PngWriter::finish`] then also waits until every such sender is dropped.
+    pub fn sender(&self) -> Option<SyncSender<J>> {
+        self.sender.clone()
+    }
+
+    /// Queues `job` (its folder is created when written). Fails with the writer's error if
+    /// an earlier write failed.
+    pub fn write(&mut self, job: J) -> Result<()> {
+        let sent = self.sender.as_ref().is_some_and(|s| s.send(job).is_ok());
         if sent {
             return Ok(());
         }
@@ -206,7 +246,8 @@ impl PngWriter {
         Err(anyhow!("the overlay writer stopped"))
     }
 
-    /// Waits until every queued image is written; what was written, or the first failure.
+    /// Waits until every queued job is written (and every [`PngWriter::sender`] dropped);
+    /// what was written, or the first failure.
     pub fn finish(mut self) -> Result<PngStats> {
         self.join()
     }
@@ -238,8 +279,9 @@ pub(crate) fn write_png(path: &Path, image: &RgbImage, made: &mut Option<PathBuf
         .with_context(|| format!("cannot write overlay {}", path.display()))
 }
 
-impl Drop for PngWriter {
-    /// Waits for the queued images (so none is left half written); errors are for `finish`.
+impl<J> Drop for PngWriter<J> {
+    /// Waits for the queued jobs (so none is left half written) and for every
+    /// [`PngWriter::sender`] to be dropped; errors are for `finish`.
     fn drop(&mut self) {
         self.sender = None;
         if let Some(thread) = self.thread.take() {

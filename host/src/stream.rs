@@ -13,9 +13,9 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{anyhow, ensure, Context, Result};
-use digiteyes_board_linux::camera::V4l2Camera;
 use digiteyes_core::protocol::{State, TrackerParams};
 use digiteyes_core::tracker::FrameReport;
+use digiteyes_platform_linux::camera::V4l2Camera;
 
 use crate::link::{
     DropCause, FrameOutcome, Link, LinkReport, Session, SessionSetup, DEFAULT_REPLY_TIMEOUT,

@@ -169,7 +169,7 @@ pub fn track_sequence_with(
                     &config.features,
                 )
                 .with_context(|| format!("{}", sequence.frame_path(c, k).display()))?;
-                writer.write(overlay_path(dir, c, k), drawn)?;
+                writer.write((overlay_path(dir, c, k), drawn))?;
             }
         }
         lost += usize::from(report.lost);

@@ -90,9 +90,9 @@ fn a_board_on_a_serial_port_feeds_the_page() {
 
 #[test]
 fn a_board_with_its_own_camera_is_set_up_from_a_sequence_folder() {
-    use digiteyes_board_linux::SimOptions;
     use digiteyes_host::link::{set_up_board, Link};
     use digiteyes_host::scenarios::{render_scenario, RenderOptions};
+    use digiteyes_host::sim::SimOptions;
 
     let dir = tempfile::tempdir().unwrap();
     let seq = dir.path().join("mouse");

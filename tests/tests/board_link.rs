@@ -5,11 +5,11 @@
 use std::path::Path;
 use std::time::Duration;
 
-use digiteyes_board_linux::{Corruption, SimBoard, SimOptions, SimReport, Window};
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::protocol::DropReason;
 use digiteyes_host::link::{DropCause, FrameOutcome, Link, Session, SessionSetup};
 use digiteyes_host::sequence::Sequence;
+use digiteyes_host::sim::{Corruption, SimBoard, SimOptions, SimReport, Window};
 use digiteyes_host::{
     render_scenario, sequence_tracker, stream_sequence, RenderOptions, StreamOptions,
     StreamSummary, TrackerConfig,

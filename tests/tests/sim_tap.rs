@@ -7,10 +7,10 @@ use std::path::Path;
 use std::sync::mpsc::sync_channel;
 use std::time::Duration;
 
-use digiteyes_board_linux::{FrameTap, SimBoard, SimFrame, SimOptions, SimReport, TapMode};
 use digiteyes_host::link::FrameOutcome;
 use digiteyes_host::overlay::{colours, overlay_path};
 use digiteyes_host::sequence::Sequence;
+use digiteyes_host::sim::{FrameTap, SimBoard, SimFrame, SimOptions, SimReport, TapMode};
 use digiteyes_host::{stream_sequence, StreamOptions, StreamSummary};
 
 mod common;
@@ -130,7 +130,7 @@ fn sim_overlay_writes_every_tracked_frame_as_a_png() {
 
 #[test]
 fn sim_ui_shows_the_last_tracked_frame_and_its_state() {
-    use digiteyes_host::ui::board_tap::ui_tap;
+    use digiteyes_host::sim::ui_tap::ui_tap;
     use digiteyes_host::ui::Hub;
 
     let dir = tempfile::tempdir().unwrap();

@@ -6,10 +6,10 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use digiteyes_board_linux::{SimBoard, SimOptions};
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::protocol::TrackerParams;
 use digiteyes_host::sequence::{read_states, Sequence};
+use digiteyes_host::sim::{SimBoard, SimOptions};
 use digiteyes_host::stereo::{stream_stereo, wire_config, StereoOptions, StereoSummary};
 use digiteyes_host::{render_scenario, sequence_tracker, RenderOptions, TrackerConfig};
 

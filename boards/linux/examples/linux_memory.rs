@@ -3,10 +3,11 @@
 
 use std::mem::size_of;
 
-use digiteyes_board_linux::{MonotonicClock, Source, StatusLed, TtySerial};
+use digiteyes_board_linux::{Source, StatusLed};
 use digiteyes_core::protocol::{Decoder, MAX_MESSAGE};
 use digiteyes_core::tracker::Tracker;
 use digiteyes_firmware::Board;
+use digiteyes_platform_linux::{MonotonicClock, TtySerial};
 
 fn main() {
     let board = size_of::<Board<'static, TtySerial, Source, StatusLed, MonotonicClock>>();

@@ -5,10 +5,10 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use digiteyes_board_linux::{
-    camera::V4l2Camera, parse_frame_size, MonotonicClock, Source, StatusLed, TtySerial, BOARD_NAME,
-};
+use digiteyes_board_linux::{Source, StatusLed, BOARD_NAME};
 use digiteyes_firmware::{Board, NoLed, Uploads};
+use digiteyes_platform_linux::camera::V4l2Camera;
+use digiteyes_platform_linux::{parse_frame_size, MonotonicClock, TtySerial};
 use linux_embedded_hal::Delay;
 
 /// The digiteyes board on a Linux computer (Raspberry-Pi class).

@@ -2,7 +2,7 @@
 
 use digiteyes_firmware::{FrameSource, SourceError, Uploads};
 
-use crate::camera::V4l2Camera;
+use digiteyes_platform_linux::camera::V4l2Camera;
 
 /// The board's frame source, chosen at start-up.
 #[derive(Debug)]

@@ -66,7 +66,7 @@ pub struct RobustnessArgs {
     pub frames: usize,
     /// Image size rendered, WxH.
     #[arg(long, value_name = "WxH", default_value = "640x480",
-          value_parser = digiteyes_board_linux::parse_frame_size)]
+          value_parser = digiteyes_platform_linux::parse_frame_size)]
     pub size: (u32, u32),
     /// Seeds rendered and tracked at once.
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(1..=64))]

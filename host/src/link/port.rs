@@ -4,10 +4,10 @@ use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Context, Result};
-use digiteyes_board_linux::TtySerial;
 use digiteyes_core::protocol::{
     encode, BoardMessage, Decoder, HostMessage, LinkCounters, MAX_MESSAGE,
 };
+use digiteyes_platform_linux::TtySerial;
 
 /// Longest single wait inside [`Link::recv_until`], so a deadline is met closely.
 const WAIT_STEP: Duration = Duration::from_millis(20);

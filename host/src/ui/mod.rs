@@ -7,7 +7,7 @@
 //! - the 3D hand at the newest state, drawn from the model's shapes (drag to orbit, wheel to
 //!   zoom), with the table and the 3D mouse's pole when the hand is above the table;
 //! - the newest camera frame with the model drawn over it, when frames are available (a
-//!   replay, the demo, a simulated board: [`board_tap`]);
+//!   replay, the demo, a simulated board: [`crate::sim::ui_tap`]);
 //! - the 3D mouse (thesis Sec. 4.3.4): the pole's base on the table, its height, two buttons;
 //! - every state's value, and the link's figures: states/s, drops by reason, CRC and framing
 //!   errors, and whether the track is lost or the signal gone.
@@ -16,7 +16,6 @@
 //! source thread (serial | UDP | replay | simulated board) ─▶ Hub ◀─ HTTP thread ◀─ browser
 //! ```
 
-pub mod board_tap;
 pub mod hub;
 pub mod server;
 pub mod sources;

@@ -1,23 +1,24 @@
 //! The simulated board's serial line: the PTY, plus what a test bench adds to it — a tap that
-//! watches the host's messages, line noise, and the trigger of a power cycle.
+//! watches the host's messages, a deaf spell, and the trigger of a power cycle. Line noise is
+//! not here: it is a [`FaultInjector`](super::FaultInjector) between this line and the board.
 //!
 //! Inbound bytes are handed to the board one message at a time (up to and including each
 //! frame delimiter): the tap decodes a message before the board sees it, so noise can be
-//! aimed at the chunks of given frames and a power cycle can fall right after a given chunk.
-//! The board sees the same bytes in the same order, only a message later at most.
+//! aimed at the chunks of given frames ([`UploadedFrame`]) and a power cycle can fall right
+//! after a given chunk. The board sees the same bytes in the same order, only a message later
+//! at most.
 
-use std::cell::RefCell;
 use std::collections::VecDeque;
 use std::io;
-use std::rc::Rc;
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use digiteyes_core::protocol::{Decoder, HostMessage, MAX_MESSAGE};
+use digiteyes_platform_linux::TtySerial;
+use embedded_io::{Read, ReadReady};
 
-use super::corrupt::{Corruption, Noise, Position};
+use super::fault_injector::UploadedFrame;
 use super::{Deafness, SimReport};
-use crate::serial::TtySerial;
 
 /// Most inbound bytes held back waiting for a delimiter; past this they go to the board as
 /// they are (its decoder counts the overflow).
@@ -26,7 +27,6 @@ const HOLD_LIMIT: usize = 2 * MAX_MESSAGE;
 /// The line and its bench state; shared by the successive boards of a power-cycled run.
 pub(crate) struct Line {
     tty: TtySerial,
-    started: Instant,
     /// Bytes read from the PTY, not yet looked at.
     raw: VecDeque<u8>,
     /// The message being collected (up to its delimiter).
@@ -34,7 +34,6 @@ pub(crate) struct Line {
     /// Bytes released to the board.
     ready: VecDeque<u8>,
     tap: Decoder<MAX_MESSAGE>,
-    noise: Option<(Corruption, Noise)>,
     /// The frame of the last `FrameChunk` released to the board.
     last_frame: Option<u32>,
     /// Distinct frames whose chunks were released.
@@ -45,38 +44,27 @@ pub(crate) struct Line {
     hold: bool,
     /// Lose the host's bytes during these uploads.
     deaf: Option<Deafness>,
-    bytes_in: u64,
-    bytes_out: u64,
     report: Arc<Mutex<SimReport>>,
 }
 
 impl Line {
     pub(crate) fn new(
         tty: TtySerial,
-        corruption: Option<Corruption>,
         restart_after: Option<u32>,
         deaf: Option<Deafness>,
         report: Arc<Mutex<SimReport>>,
     ) -> Self {
-        let noise = corruption.map(|c| {
-            let noise = Noise::new(c.seed, c.rate);
-            (c, noise)
-        });
         Line {
             tty,
-            started: Instant::now(),
             raw: VecDeque::new(),
             pending: Vec::new(),
             ready: VecDeque::new(),
             tap: Decoder::new(),
-            noise,
             last_frame: None,
             frames_started: 0,
             restart_after,
             hold: false,
             deaf,
-            bytes_in: 0,
-            bytes_out: 0,
             report,
         }
     }
@@ -105,7 +93,6 @@ impl Line {
     }
 
     fn pull(&mut self) -> io::Result<()> {
-        use embedded_io::{Read, ReadReady};
         while self.tty.read_ready()? {
             let mut buf = [0u8; 1024];
             let n = self.tty.read(&mut buf)?;
@@ -131,7 +118,7 @@ impl Line {
     }
 
     fn release_pending(&mut self) {
-        let mut message = std::mem::take(&mut self.pending);
+        let message = std::mem::take(&mut self.pending);
         let (_, decoded) = self.tap.feed::<HostMessage>(&message);
         let chunk = match decoded {
             Some(Ok(HostMessage::FrameChunk(c))) => Some(c.frame),
@@ -151,26 +138,8 @@ impl Line {
             self.update_report(|r| r.deaf_in += n);
             return;
         }
-        let frame = chunk.or(self.last_frame);
-        let mut hits = 0;
-        if let Some((corruption, noise)) = &mut self.noise {
-            for (i, byte) in message.iter_mut().enumerate() {
-                let at = Position {
-                    byte: self.bytes_in + i as u64,
-                    frame,
-                    elapsed: self.started.elapsed(),
-                };
-                if corruption.window.contains(at) && noise.hit(byte) {
-                    hits += 1;
-                }
-            }
-        }
-        self.bytes_in += message.len() as u64;
         let n = message.len() as u64;
-        self.update_report(|r| {
-            r.bytes_in += n;
-            r.corrupted_in += hits;
-        });
+        self.update_report(|r| r.bytes_in += n);
         self.ready.extend(message);
         if chunk.is_some() && self.restart_after.is_some_and(|n| self.frames_started > n) {
             self.hold = true;
@@ -182,7 +151,21 @@ impl Line {
             f(&mut report);
         }
     }
+}
 
+impl UploadedFrame for Line {
+    /// The frame of the last `FrameChunk` released to the board: the bytes it reads now are
+    /// that chunk's, or a message sent during that frame's upload.
+    fn uploaded_frame(&self) -> Option<u32> {
+        self.last_frame
+    }
+}
+
+impl embedded_io::ErrorType for Line {
+    type Error = io::Error;
+}
+
+impl embedded_io::ReadReady for Line {
     fn read_ready(&mut self) -> io::Result<bool> {
         if self.ready.is_empty() {
             self.pull()?;
@@ -190,9 +173,11 @@ impl Line {
         }
         Ok(!self.ready.is_empty())
     }
+}
 
+impl embedded_io::Read for Line {
+    /// Bytes of one message at most (see the module's doc).
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        use embedded_io::Read;
         while self.ready.is_empty() && !buf.is_empty() {
             self.release();
             if self.ready.is_empty() {
@@ -207,58 +192,17 @@ impl Line {
         }
         Ok(n)
     }
+}
 
+impl embedded_io::Write for Line {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        use embedded_io::Write;
-        let mut bytes = buf.to_vec();
-        let mut hits = 0;
-        if let Some((corruption, noise)) = &mut self.noise {
-            for (i, byte) in bytes.iter_mut().enumerate() {
-                let at = Position {
-                    byte: self.bytes_out + i as u64,
-                    frame: self.last_frame,
-                    elapsed: self.started.elapsed(),
-                };
-                if corruption.window.contains(at) && noise.hit(byte) {
-                    hits += 1;
-                }
-            }
-        }
-        self.tty.write_all(&bytes)?;
-        self.bytes_out += bytes.len() as u64;
-        let (n, discarded) = (bytes.len() as u64, self.tty.discarded());
+        self.tty.write_all(buf)?;
+        let (n, discarded) = (buf.len() as u64, self.tty.discarded());
         self.update_report(|r| {
             r.bytes_out += n;
-            r.corrupted_out += hits;
             r.discarded_out = discarded;
         });
         Ok(buf.len())
-    }
-}
-
-/// One board's handle on the [`Line`]: the serial port the firmware is given. Dropping the
-/// board drops only the handle; the next board gets a new one on the same line.
-pub(crate) struct SimPort(pub(crate) Rc<RefCell<Line>>);
-
-impl embedded_io::ErrorType for SimPort {
-    type Error = io::Error;
-}
-
-impl embedded_io::Read for SimPort {
-    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        self.0.borrow_mut().read(buf)
-    }
-}
-
-impl embedded_io::ReadReady for SimPort {
-    fn read_ready(&mut self) -> io::Result<bool> {
-        self.0.borrow_mut().read_ready()
-    }
-}
-
-impl embedded_io::Write for SimPort {
-    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.0.borrow_mut().write(buf)
     }
 
     fn flush(&mut self) -> io::Result<()> {

@@ -1,17 +1,25 @@
-//! The simulated board: the firmware's [`Board`] on one side of a pseudo-terminal pair this
-//! process creates, in a thread; a host connects to the other side's path (`/dev/pts/N`)
-//! exactly as it would to a UART.
+//! The simulated board (`digiteyes sim`, `digiteyes demo`, the link tests): the firmware's
+//! [`Board`] on one side of a pseudo-terminal pair this process creates, in a thread; a host
+//! connects to the other side's path (`/dev/pts/N`) exactly as it would to a UART. The
+//! platform under it is the Linux board's (`digiteyes-platform-linux`: the tty port, the
+//! clock); the rest lives here, in one place:
 //!
-//! For robustness tests the line can be noisy ([`Corruption`]) and the board can be
-//! power-cycled once mid-run ([`SimOptions::restart_after`]): the [`Board`] is dropped and a
-//! new one boots on the same PTY, losing whatever it had received of the frame in flight.
-//!
-//! A host can also see what the board tracks: with [`SimOptions::frame_tap`] every tracked
-//! frame comes back as a [`SimFrame`] (pixels, the state sent, camera) over a channel.
+//! - [`fault_injector`]: line noise ([`Corruption`]), an embedded-io wrapper around the
+//!   board's serial port in the manner of smoltcp's fault injector;
+//! - `line`: the PTY as the board reads it, one host message at a time, with a deaf spell
+//!   ([`SimOptions::deaf`]) and the trigger of a power cycle ([`SimOptions::restart_after`]:
+//!   the [`Board`] is dropped and a new one boots on the same PTY, losing whatever it had
+//!   received of the frame in flight);
+//! - [`tap`]: with [`SimOptions::frame_tap`] every tracked frame comes back as a [`SimFrame`]
+//!   (pixels, the state sent, camera) over a channel; [`overlay`] draws them as PNGs
+//!   (`sim --overlay`) and [`ui_tap`] feeds them to the UI page (`sim --ui`).
 
-mod corrupt;
+pub mod fault_injector;
 mod line;
-mod tap;
+pub mod overlay;
+mod port;
+pub mod tap;
+pub mod ui_tap;
 
 use std::cell::RefCell;
 use std::fmt;
@@ -23,16 +31,18 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
+use anyhow::Context;
 use digiteyes_core::protocol::Stats;
 use digiteyes_firmware::{Board, NoLed, Tracked, Uploads};
+use digiteyes_platform_linux::{MonotonicClock, TtySerial};
 use serialport::{SerialPort, TTYPort};
 
-pub use corrupt::{Corruption, Window};
+pub use fault_injector::{Corruption, FaultInjector, Window};
+pub use overlay::{overlay_tap, OVERLAY_QUEUE};
 pub use tap::{FrameTap, SimFrame, TapMode};
 
-use crate::clock::MonotonicClock;
-use crate::serial::TtySerial;
-use line::{Line, SimPort};
+use line::Line;
+use port::SimPort;
 
 /// The board name the simulator reports in `Hello`.
 pub const SIM_BOARD_NAME: &str = "linux-sim";
@@ -269,12 +279,9 @@ fn run(
     stop: &AtomicBool,
     report: &Arc<Mutex<SimReport>>,
 ) -> io::Result<()> {
-    let line = Rc::new(RefCell::new(Line::new(
-        tty,
+    let line = Rc::new(RefCell::new(FaultInjector::new(
+        Line::new(tty, options.restart_after, options.deaf, report.clone()),
         options.corruption.clone(),
-        options.restart_after,
-        options.deaf,
-        report.clone(),
     )));
     let mut frame_buffer = vec![0u8; options.frame_buffer_bytes];
     let note = |f: &dyn Fn(&mut SimReport)| {
@@ -294,7 +301,10 @@ fn run(
             SIM_BOARD_NAME,
             &mut frame_buffer,
             None,
-            SimPort(line.clone()),
+            SimPort {
+                line: line.clone(),
+                report: report.clone(),
+            },
             Uploads,
             NoLed,
             MonotonicClock::new(),
@@ -311,7 +321,7 @@ fn run(
                 note(&|r| r.board = stats);
                 return Ok(());
             }
-            if line.borrow().restart_due() {
+            if line.borrow().inner().restart_due() {
                 break;
             }
             let busy = match board.poll() {
@@ -324,11 +334,17 @@ fn run(
             let stats = board.stats();
             note(&|r| r.board = stats);
             if !busy {
-                line.borrow_mut().wait_input(IDLE_WAIT)?;
+                line.borrow_mut().inner_mut().wait_input(IDLE_WAIT)?;
             }
         }
         drop(board);
-        line.borrow_mut().power_cycled();
+        line.borrow_mut().inner_mut().power_cycled();
         boot += 1;
     }
+}
+
+/// Starts the simulated board and returns it (its [`SimBoard::path`] is the device to
+/// connect to); the error says it was the simulated board that could not start.
+pub fn start(options: SimOptions) -> anyhow::Result<SimBoard> {
+    SimBoard::start(options).context("cannot start the simulated board on a pseudo-terminal")
 }

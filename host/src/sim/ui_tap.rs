@@ -6,11 +6,11 @@ use std::sync::mpsc::{sync_channel, Receiver};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 
+use super::{FrameTap, SimFrame};
 use anyhow::{Context, Result};
-use digiteyes_board_linux::{FrameTap, SimFrame};
 use image::GrayImage;
 
-use super::hub::{CameraFrame, Hub, ShownState};
+use crate::ui::hub::{CameraFrame, Hub, ShownState};
 
 /// Frames waiting for the UI before the board skips handing it more (a live view needs the
 /// newest frame, not every one; the board never waits for the UI).

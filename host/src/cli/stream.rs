@@ -1,0 +1,138 @@
+//! `digiteyes stream`: frames to one board, or to one board per camera, and the states back.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use clap::Args;
+use digiteyes_core::protocol::TrackerParams;
+
+use super::tracker_config;
+use crate::cli_values;
+use crate::stereo::{stream_stereo, StereoOptions};
+use crate::stream::{stream_camera, stream_sequence, StreamOptions, DEFAULT_BAUD};
+
+/// Stream frames to a board over a serial link and write the states it sends back.
+///
+/// Sets the board up (Configure: the camera from sequence.json and the default tracker
+/// parameters; Reset: initial_state and free from sequence.json), checks its Hello
+/// (protocol version; the board's model must be the sequence's), then uploads each frame
+/// as FrameChunks and waits for its State or Dropped. A board that reboots mid-stream is
+/// set up again from the last state. Writes the same CSV as `track` (every frame, in
+/// order) plus a last column `dropped`: empty for tracked frames; for a frame the board
+/// did not track, the reason (incomplete, wrong size WxH, too large, not ready,
+/// superseded, tracker error, no reply (timeout), board restarted) — its row repeats the
+/// last state with lost = 1. Prints a summary and the link's figures (states/s, bytes,
+/// CRC/framing errors on both ends, the board's drops by reason). A board tracks one
+/// camera: a stereo sequence needs --camera-index, or one board per camera.
+///
+/// One board per camera (--port given once per camera of --seq, in camera order), as the
+/// thesis' stereo system ran: each board holds its camera's frames (Hold); per
+/// Gauss–Newton iteration the host sends the state to every board (Measure), each
+/// searches its own frame at it and answers with the edges and tips it found, and the
+/// host solves once with all of them — the same states as `track` on the sequence with
+/// the same --iterations. A board that does not answer within --reply-timeout is left
+/// out (the other cameras carry on, and the summary says so) and taken back as soon as
+/// it answers again. docs/link.md has the bytes per iteration and the rates they allow.
+#[derive(Args, Debug)]
+pub struct StreamArgs {
+    /// The board or boards.
+    #[command(flatten)]
+    pub port: StreamPorts,
+    /// Sequence folder whose frames to upload.
+    #[arg(
+        long,
+        value_name = "DIR",
+        required_unless_present = "camera",
+        conflicts_with = "camera"
+    )]
+    pub seq: Option<PathBuf>,
+    /// Capture the frames from this V4L2 camera on the host instead (GREY, YUYV or MJPEG);
+    /// needs --setup.
+    #[arg(long, value_name = "/dev/videoN", requires = "setup")]
+    pub camera: Option<PathBuf>,
+    /// With --camera: a sequence.json giving the model, the camera's calibration (its
+    /// size is the capture size), the initial state and the free states.
+    #[arg(long, value_name = "FILE")]
+    pub setup: Option<PathBuf>,
+    /// With --camera: frames to capture.
+    #[arg(long, value_name = "N", default_value_t = 300)]
+    pub frames: usize,
+    /// The camera of a multi-camera sequence to track (0-based).
+    #[arg(long, value_name = "N")]
+    pub camera_index: Option<usize>,
+    /// Gauss–Newton iterations per frame, 1 to 50 (default: the tracker's, 8; the thesis
+    /// ran one per frame).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(1..=50))]
+    pub iterations: Option<u8>,
+    /// Output CSV path (default: states.csv in the current folder).
+    #[arg(long, short, default_value = "states.csv", hide_default_value = true)]
+    pub out: PathBuf,
+    /// No progress bar.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// The boards `stream` talks to: one, or one per camera.
+#[derive(Args, Debug)]
+pub struct StreamPorts {
+    /// A board's serial device: a UART or USB serial adapter (/dev/ttyUSB0), or a
+    /// pseudo-terminal `digiteyes sim` printed (/dev/pts/N). Give it once per camera of a
+    /// stereo --seq (in camera order) for one board per camera.
+    #[arg(long, value_name = "TTY", required = true, num_args = 1)]
+    pub port: Vec<String>,
+    /// Line speed in bits/s (8N1; ignored by pseudo-terminals).
+    #[arg(long, value_name = "B", default_value_t = DEFAULT_BAUD)]
+    pub baud: u32,
+    /// Seconds to wait for each answer of a board (a frame's State or Dropped, an Ack, the
+    /// answer to a Measure). Without a frame's answer by then, a Ping probes for as long
+    /// again (a slow answer still counts); then the frame counts as dropped, "no reply
+    /// (timeout)". With one board per camera, a board that does not answer a Measure in time
+    /// is left out until it answers again. At most a week.
+    #[arg(long, value_name = "S", default_value_t = 2.0, value_parser = cli_values::positive_seconds)]
+    pub reply_timeout: f64,
+}
+
+/// Streams to the board(s), writes the CSV and prints the summary; fails when no frame was
+/// tracked.
+pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
+    let port = args.port;
+    let tracker = TrackerParams::from_config(&tracker_config(args.iterations, false));
+    if port.port.len() > 1 {
+        let Some(seq) = args.seq else {
+            bail!(
+                "one board per camera (--port given {} times) needs --seq DIR: a                          sequence with that many cameras",
+                port.port.len()
+            );
+        };
+        if args.camera_index.is_some() {
+            bail!("--camera-index picks the one camera of a single board; with one --port per camera leave it out");
+        }
+        let mut options = StereoOptions::new(port.port);
+        options.baud = port.baud;
+        options.reply_timeout = cli_values::duration(port.reply_timeout);
+        options.tracker = tracker;
+        options.progress = progress && !args.quiet;
+        let summary = stream_stereo(&seq, &args.out, &options)?;
+        print!("{summary}");
+        if summary.frames == summary.lost_frames {
+            bail!("every frame was lost: no board measured the hand");
+        }
+        return Ok(());
+    }
+    let port_path = port.port.first().cloned().unwrap_or_default();
+    let mut options = StreamOptions::new(&port_path)
+        .baud(port.baud)
+        .reply_timeout(cli_values::duration(port.reply_timeout))
+        .camera_index(args.camera_index)
+        .progress(progress && !args.quiet);
+    options.tracker = tracker;
+    let summary = match (args.seq, args.camera, args.setup) {
+        (Some(seq), None, _) => stream_sequence(&seq, &args.out, &options)?,
+        (None, Some(camera), Some(setup)) => {
+            stream_camera(&camera, &setup, args.frames, &args.out, &options)?
+        }
+        _ => bail!("give --seq DIR, or --camera /dev/videoN with --setup FILE"),
+    };
+    println!("{summary}");
+    summary.ensure_some_tracked()
+}
