@@ -45,11 +45,13 @@ fn main() {
     let tracker = size_of::<Tracker>();
     let model = size_of::<Model>();
     let decoder = size_of::<Decoder<MAX_MESSAGE>>();
+    let measuring = size_of::<Option<digiteyes_core::remote::MeasureWork>>();
     println!("board (all but frame buffers): {board} B");
     println!("  tracker (incl. its model and working memory): {tracker} B");
     println!("  board's own copy of the model: {model} B");
     println!("  receive buffer (decoder): {decoder} B");
     println!("  transmit buffer: {MAX_MESSAGE} B");
+    println!("  measuring memory (one board per camera, after Hold): {measuring} B");
     for (name, w, h) in [("QQVGA", 160, 120), ("QVGA", 320, 240), ("VGA", 640, 480)] {
         println!(
             "frame buffer {name} {w}x{h}: {} B (+ the same again for an overlay)",
