@@ -103,6 +103,11 @@ pub struct AcquireConfig {
     pub normals: u8,
     /// Coarse turns about each normal.
     pub spins: u8,
+    /// Levels of the template tree after the coarse slide (each slides children of the best
+    /// templates locally: turned, moved in depth, other finger poses).
+    pub tree_levels: u8,
+    /// First steps of the template tree: palm rotation (rad), depth (mm).
+    pub tree_steps: [f32; 2],
     /// Rounds of local refinement.
     pub refine_rounds: u8,
     /// First refinement steps: palm translation (mm), palm rotation (rad), finger bend (rad).
@@ -114,11 +119,13 @@ pub struct AcquireConfig {
 impl Default for AcquireConfig {
     fn default() -> Self {
         AcquireConfig {
-            evaluations_per_frame: 400,
+            evaluations_per_frame: 1000,
             depths: 3,
-            slide_step: 1.0 / 40.0,
+            slide_step: 1.0 / 20.0,
             normals: 20,
             spins: 6,
+            tree_levels: 3,
+            tree_steps: [0.35, 60.0],
             refine_rounds: 4,
             refine_steps: [30.0, 0.35, 0.4],
             likelihood: LikelihoodConfig::default(),
@@ -151,6 +158,7 @@ pub enum Progress {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Stage {
     Coarse(u32),
+    Tree { level: u8, next: u32 },
     Fingers(u32),
     Refine { round: u8, next: u32 },
     Done,
@@ -315,6 +323,28 @@ impl Acquirer {
                     cost = (self.lookups / LOOKUPS_PER_EVALUATION).max(1);
                 }
                 let cost = u16::try_from(cost).unwrap_or(u16::MAX);
+                self.largest_item_cost = self.largest_item_cost.max(cost);
+                evaluated = evaluated.saturating_add(cost);
+                self.evaluations += 1;
+                self.advance();
+                continue;
+            }
+            if let Stage::Tree { level, next } = self.stage {
+                let (Some(camera), Some(map)) = (cameras.first(), edges.first()) else {
+                    self.finish_level();
+                    continue;
+                };
+                let Some(child) = self.tree_child(camera, level, next) else {
+                    self.finish_level();
+                    continue;
+                };
+                self.lookups = 0;
+                let near = camera.width as f32 * self.config.slide_step * 2.0;
+                if let Some(c) = self.place(model, camera, map, child, Some(near)) {
+                    keep(&mut self.next, c);
+                }
+                let cost =
+                    u16::try_from(1 + self.lookups / LOOKUPS_PER_EVALUATION).unwrap_or(u16::MAX);
                 self.largest_item_cost = self.largest_item_cost.max(cost);
                 evaluated = evaluated.saturating_add(cost);
                 self.evaluations += 1;
@@ -523,6 +553,10 @@ impl Acquirer {
     fn advance(&mut self) {
         self.stage = match self.stage {
             Stage::Coarse(i) => Stage::Coarse(i + 1),
+            Stage::Tree { level, next } => Stage::Tree {
+                level,
+                next: next + 1,
+            },
             Stage::Fingers(i) => Stage::Fingers(i + 1),
             Stage::Refine { round, next } => Stage::Refine {
                 round,
@@ -534,15 +568,24 @@ impl Acquirer {
 
     /// Ends a level: its best become the seeds of the next.
     fn finish_level(&mut self) {
-        // Refinement and the finger level keep the seeds themselves in the running.
-        if !matches!(self.stage, Stage::Coarse(_)) {
+        // Refinement and the finger level keep the seeds themselves in the running; the first
+        // full-score level re-scores them (its first hypothesis of each seed is the seed).
+        if !matches!(self.stage, Stage::Coarse(_) | Stage::Fingers(_)) {
             for c in self.best.clone() {
                 keep(&mut self.next, c);
             }
         }
         self.best = core::mem::take(&mut self.next);
         self.stage = match self.stage {
+            Stage::Coarse(_) if !self.best.is_empty() && self.config.tree_levels > 0 => {
+                Stage::Tree { level: 0, next: 0 }
+            }
             Stage::Coarse(_) if !self.best.is_empty() => Stage::Fingers(0),
+            Stage::Tree { level, .. } if level + 1 < self.config.tree_levels => Stage::Tree {
+                level: level + 1,
+                next: 0,
+            },
+            Stage::Tree { .. } => Stage::Fingers(0),
             Stage::Fingers(_) => Stage::Refine { round: 0, next: 0 },
             Stage::Refine { round, .. } if round + 1 < self.config.refine_rounds => Stage::Refine {
                 round: round + 1,
@@ -555,7 +598,7 @@ impl Acquirer {
     /// The hypothesis at the current place of the search; `None` when the level is over.
     fn hypothesis(&self) -> Option<[f32; MAX_STATES]> {
         match self.stage {
-            Stage::Coarse(_) => None,
+            Stage::Coarse(_) | Stage::Tree { .. } => None,
             Stage::Fingers(i) => {
                 let poses = FINGER_POSES.len() as u32;
                 let seed = self.best.get((i / poses) as usize)?;
@@ -566,6 +609,42 @@ impl Acquirer {
             Stage::Refine { round, next } => self.refined(round, next),
             Stage::Done => None,
         }
+    }
+
+    /// Child `next` of the tree level `level` around the kept templates: the seed itself, its
+    /// palm turned either way about each axis, moved nearer and farther along `camera`'s ray,
+    /// or its fingers in another pose; steps halve each level.
+    fn tree_child(&self, camera: &Camera, level: u8, next: u32) -> Option<[f32; MAX_STATES]> {
+        const POSES: [usize; 3] = [0, 3, 4]; // open, half curl, fist
+        const CHILDREN: u32 = 1 + 6 + 2 + POSES.len() as u32;
+        let seed = self.best.get((next / CHILDREN) as usize)?;
+        let m = next % CHILDREN;
+        let scale = 1.0 / (1u32 << level) as f32;
+        let mut q = seed.q;
+        let sign = if m.is_multiple_of(2) { 1.0 } else { -1.0 };
+        match m {
+            0 => {}
+            1..=6 if self.frees(QUATERNION) => {
+                let mut axis = [0.0f32; 3];
+                axis[((m - 1) / 2) as usize] = sign;
+                let turned = compose(
+                    &[q[0], q[1], q[2], q[3]],
+                    &axis_angle(axis, self.config.tree_steps[0] * scale),
+                );
+                q[..4].copy_from_slice(&turned);
+            }
+            7 | 8 if self.frees(TRANSLATION) => {
+                let eye = camera.centre();
+                let p = Vector3::new(q[4], q[5], q[6]);
+                let along = p - eye;
+                let len = along.norm().max(1.0);
+                let moved = p + along / len * (sign * self.config.tree_steps[1] * scale);
+                q[4..7].copy_from_slice(&[moved.x, moved.y, moved.z]);
+            }
+            9.. => self.set_fingers(&mut q, POSES[(m - 9) as usize]),
+            _ => return Some(seed.q),
+        }
+        Some(q)
     }
 
     /// Neighbour `next` of the refinement round `round` around the kept seeds.

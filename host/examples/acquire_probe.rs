@@ -27,7 +27,7 @@ struct Args {
     frames: usize,
     #[arg(long, default_value_t = 320)]
     width: u32,
-    #[arg(long, default_value_t = 400)]
+    #[arg(long, default_value_t = 1000)]
     budget: u16,
     #[arg(long, default_value_t = 20)]
     normals: u8,
