@@ -314,19 +314,13 @@ impl Acquirer {
                     self.finish_level();
                     continue;
                 }
-                let mut cost = 1;
+                self.lookups = 0;
                 if let (Some(camera), Some(edges)) = (cameras.first(), edges.first()) {
-                    self.lookups = 0;
                     if let Some(c) = self.slide_template(model, camera, edges, i) {
                         keep(&mut self.next, c);
                     }
-                    cost = (self.lookups / LOOKUPS_PER_EVALUATION).max(1);
                 }
-                let cost = u16::try_from(cost).unwrap_or(u16::MAX);
-                self.largest_item_cost = self.largest_item_cost.max(cost);
-                evaluated = evaluated.saturating_add(cost);
-                self.evaluations += 1;
-                self.advance();
+                evaluated = evaluated.saturating_add(self.finish_item(0));
                 continue;
             }
             if let Stage::Tree { level, next } = self.stage {
@@ -343,12 +337,7 @@ impl Acquirer {
                 if let Some(c) = self.place(model, camera, map, child, Some(near)) {
                     keep(&mut self.next, c);
                 }
-                let cost =
-                    u16::try_from(1 + self.lookups / LOOKUPS_PER_EVALUATION).unwrap_or(u16::MAX);
-                self.largest_item_cost = self.largest_item_cost.max(cost);
-                evaluated = evaluated.saturating_add(cost);
-                self.evaluations += 1;
-                self.advance();
+                evaluated = evaluated.saturating_add(self.finish_item(1));
                 continue;
             }
             let Some(q) = self.hypothesis() else {
@@ -370,12 +359,8 @@ impl Acquirer {
                 _ => q,
             };
             let score = self.score(model, cameras, frames, edges, &q);
-            let cost = u16::try_from(1 + self.lookups / LOOKUPS_PER_EVALUATION).unwrap_or(u16::MAX);
-            self.largest_item_cost = self.largest_item_cost.max(cost);
-            evaluated = evaluated.saturating_add(cost);
-            self.evaluations += 1;
             keep(&mut self.next, Candidate { score, q });
-            self.advance();
+            evaluated = evaluated.saturating_add(self.finish_item(1));
         }
         match (self.stage, self.best.first()) {
             (Stage::Done, Some(best)) => Progress::Found(*best),
@@ -548,6 +533,17 @@ impl Acquirer {
             score: 1.0 - best.0 / cap,
             q,
         })
+    }
+
+    /// Counts a finished hypothesis or slide, moves the search on, and returns what it cost
+    /// against the budget: `scored` full evaluations plus the slide's look-ups (at least 1).
+    fn finish_item(&mut self, scored: u32) -> u16 {
+        let cost = u16::try_from((scored + self.lookups / LOOKUPS_PER_EVALUATION).max(1))
+            .unwrap_or(u16::MAX);
+        self.largest_item_cost = self.largest_item_cost.max(cost);
+        self.evaluations += 1;
+        self.advance();
+        cost
     }
 
     fn advance(&mut self) {

@@ -374,18 +374,6 @@ pub fn evaluate(
     config: &LikelihoodConfig,
 ) -> Likelihood {
     let samples = Samples::of(view, camera, config);
-    score_samples(&samples, view, camera, frame, edges, config)
-}
-
-/// [`evaluate`] with the samples already taken.
-pub fn score_samples(
-    samples: &Samples,
-    view: &ProjectedModel,
-    camera: &Camera,
-    frame: &FrameView<'_>,
-    edges: &EdgeMap<'_>,
-    config: &LikelihoodConfig,
-) -> Likelihood {
     let cap = config.chamfer_cap_px.max(1e-3);
     let (chamfer_px, inside) = samples.chamfer(edges, Vector2::zeros(), cap);
     let outside = (samples.points.len() as u16).saturating_sub(inside);

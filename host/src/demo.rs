@@ -74,12 +74,7 @@ pub fn run_demo(
     config: TrackerConfig,
     progress: bool,
 ) -> Result<DemoResult> {
-    let opts = RenderOptions {
-        frames: Some(frames),
-        progress,
-        ..RenderOptions::default()
-    };
-    render_scenario(DEMO_SCENARIO, dir, &opts)?;
+    render_demo(DEMO_SCENARIO, frames, dir, progress)?;
     let board = crate::sim::start(SimOptions::default())?;
     let port = board.path().display().to_string();
     let states = dir.join("states.csv");
@@ -89,11 +84,7 @@ pub fn run_demo(
     let board = board.stop().context("the simulated board failed")?;
     let eval = evaluate(dir, &states)?;
     let mouse = mouse_accuracy(dir, &states)?;
-    let report_options = ReportOptions {
-        thumb_every: frames.div_ceil(DEMO_THUMBNAILS).max(1),
-        ..ReportOptions::default()
-    };
-    let report = write_report(dir, &states, &dir.join(REPORT_HTML), &report_options)?;
+    let report = write_demo_report(dir, &states, frames)?;
     Ok(DemoResult {
         sequence: dir.to_path_buf(),
         stream,
@@ -135,12 +126,7 @@ pub fn run_stereo_demo(
     config: TrackerConfig,
     progress: bool,
 ) -> Result<StereoDemoResult> {
-    let opts = RenderOptions {
-        frames: Some(frames),
-        progress,
-        ..RenderOptions::default()
-    };
-    render_scenario(STEREO_DEMO_SCENARIO, dir, &opts)?;
+    render_demo(STEREO_DEMO_SCENARIO, frames, dir, progress)?;
     let n_cameras = Sequence::open(dir)?.cameras.len();
     let boards = (0..n_cameras)
         .map(|_| crate::sim::start(SimOptions::default()))
@@ -159,11 +145,7 @@ pub fn run_stereo_demo(
         .map(|b| b.stop().context("a simulated board failed"))
         .collect::<Result<Vec<_>>>()?;
     let eval = evaluate(dir, &states)?;
-    let report_options = ReportOptions {
-        thumb_every: frames.div_ceil(DEMO_THUMBNAILS).max(1),
-        ..ReportOptions::default()
-    };
-    let report = write_report(dir, &states, &dir.join(REPORT_HTML), &report_options)?;
+    let report = write_demo_report(dir, &states, frames)?;
     Ok(StereoDemoResult {
         sequence: dir.to_path_buf(),
         stream,
@@ -171,6 +153,25 @@ pub fn run_stereo_demo(
         eval,
         report,
     })
+}
+
+/// Renders `scenario` into `dir` in `frames` frames, as the demos do.
+fn render_demo(scenario: &str, frames: usize, dir: &Path, progress: bool) -> Result<()> {
+    let options = RenderOptions {
+        frames: Some(frames),
+        progress,
+        ..RenderOptions::default()
+    };
+    render_scenario(scenario, dir, &options)
+}
+
+/// The demo's HTML report `dir/report.html`, with about [`DEMO_THUMBNAILS`] overlays.
+fn write_demo_report(dir: &Path, states_csv: &Path, frames: usize) -> Result<ReportSummary> {
+    let options = ReportOptions {
+        thumb_every: frames.div_ceil(DEMO_THUMBNAILS).max(1),
+        ..ReportOptions::default()
+    };
+    write_report(dir, states_csv, &dir.join(REPORT_HTML), &options)
 }
 
 /// The states in `states_csv` as a 3D mouse against the truth of the sequence in `dir`.

@@ -15,7 +15,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use digiteyes_core::protocol::{BoardMessage, State};
 use digiteyes_host::scenarios::{render_scenario, scenario, RenderOptions};
 use digiteyes_host::ui::{RunningUi, UiOptions, UiSource};
 use digiteyes_host::{track_sequence, TrackerConfig};
@@ -110,18 +109,7 @@ fn host_port(url: &str) -> String {
 }
 
 fn state_message(frame: u32, q: &[f32]) -> String {
-    let message = BoardMessage::State(State {
-        frame,
-        timestamp: u64::from(frame) * 1000,
-        q: heapless::Vec::from_slice(q).unwrap(),
-        rms_px: 0.75,
-        lost: false,
-        features_found: 40,
-        features_expected: 42,
-        iterations: 3,
-        track_ticks: 5000,
-    });
-    format!("{}\n", serde_json::to_string(&message).unwrap())
+    common::browser::state_line(frame, q)
 }
 
 /// Sends states to `to` every 40 ms until dropped, as `listen --forward udp://` would: the

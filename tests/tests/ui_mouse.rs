@@ -16,7 +16,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use digiteyes_core::protocol::{BoardMessage, State};
 use digiteyes_host::scenarios::{mouse_thesis, scenario};
 use digiteyes_host::ui::hub::Hub;
 use digiteyes_host::ui::{RunningUi, UiOptions, UiSource};
@@ -45,18 +44,7 @@ fn body_data<'a>(dom: &'a str, name: &str) -> &'a str {
 }
 
 fn state_message(frame: u32, q: &[f32]) -> String {
-    let message = BoardMessage::State(State {
-        frame,
-        timestamp: u64::from(frame) * 1000,
-        q: heapless::Vec::from_slice(q).unwrap(),
-        rms_px: 0.75,
-        lost: false,
-        features_found: 40,
-        features_expected: 42,
-        iterations: 3,
-        track_ticks: 5000,
-    });
-    format!("{}\n", serde_json::to_string(&message).unwrap())
+    common::browser::state_line(frame, q)
 }
 
 /// Plays `script` to the page one state at a time, as `listen --forward udp://` would send

@@ -64,3 +64,21 @@ pub fn chromium_run(exe: &Path, url: &str, budget_ms: u32, extra: &[String]) -> 
 pub fn dump_dom(exe: &Path, url: &str, budget_ms: u32) -> String {
     chromium_run(exe, url, budget_ms, &["--dump-dom".to_string()])
 }
+
+/// A board's `State` for `q` at `frame` as one JSON line, as `listen --forward udp://` sends
+/// it (tracked, with plausible figures).
+pub fn state_line(frame: u32, q: &[f32]) -> String {
+    use digiteyes_core::protocol::{BoardMessage, State};
+    let message = BoardMessage::State(State {
+        frame,
+        timestamp: u64::from(frame) * 1000,
+        q: heapless::Vec::from_slice(q).unwrap(),
+        rms_px: 0.75,
+        lost: false,
+        features_found: 40,
+        features_expected: 42,
+        iterations: 3,
+        track_ticks: 5000,
+    });
+    format!("{}\n", serde_json::to_string(&message).unwrap())
+}
