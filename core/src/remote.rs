@@ -98,7 +98,7 @@ impl MeasureWork {
         frame: &FrameView<'_>,
         config: &TrackerConfig,
         measure: &Measure,
-        mut send: impl FnMut(&LinkEdges),
+        mut send: impl FnMut(LinkEdges),
     ) -> Measured {
         let mut answer = Measured {
             frame: measure.frame,
@@ -139,7 +139,7 @@ impl MeasureWork {
             let link = self.view.links[index].frame;
             let edges = LinkEdges::from_features(measure, index as u8, link, &self.features);
             if !edges.is_empty() {
-                send(&edges);
+                send(edges);
                 answer.links = answer.links.saturating_add(1);
             }
         }

@@ -280,9 +280,7 @@ where
             measure,
             |edges| {
                 if failed.is_none() {
-                    if let Err(e) =
-                        send_on(serial, tx, stats, &BoardMessage::LinkEdges(edges.clone()))
-                    {
+                    if let Err(e) = send_on(serial, tx, stats, &BoardMessage::LinkEdges(edges)) {
                         failed = Some(e);
                     }
                 }

@@ -188,8 +188,6 @@ impl AutoTracker {
                     .map_err(|e| anyhow!("edge map: {e}"))?,
             );
         }
-        let model = self.tracker.model().clone();
-        let cameras = self.tracker.cameras().to_vec();
         let mut out = AutoReport {
             status: Status::Searching,
             report: FrameReport {
@@ -200,7 +198,10 @@ impl AutoTracker {
             leaf_score: None,
         };
         if self.leaves.is_empty() {
-            match self.acquirer.step(&model, &cameras, frames, &maps) {
+            match self
+                .acquirer
+                .step(self.tracker.model(), self.tracker.cameras(), frames, &maps)
+            {
                 Progress::Searching { evaluated } => out.evaluated = evaluated,
                 Progress::Found(_) => {
                     // Refine the leaves one per frame, best last (popped first).
@@ -213,7 +214,7 @@ impl AutoTracker {
         let Some(leaf) = self.leaves.pop() else {
             return Ok(out);
         };
-        let n = model.n_states().min(MAX_STATES);
+        let n = self.tracker.model().n_states().min(MAX_STATES);
         self.tracker
             .restart_fresh(&leaf[..n])
             .map_err(|e| anyhow!("the search's leaf: {e}"))?;
@@ -226,8 +227,13 @@ impl AutoTracker {
         let score = if report.lost {
             0.0
         } else {
-            self.acquirer
-                .score(&model, &cameras, frames, &maps, &refined)
+            self.acquirer.score(
+                self.tracker.model(),
+                self.tracker.cameras(),
+                frames,
+                &maps,
+                &refined,
+            )
         };
         out.leaf_score = Some(score);
         if self.best_refined.as_ref().is_none_or(|(s, _)| score > *s) {
