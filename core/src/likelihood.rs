@@ -410,6 +410,37 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_small_buffer_or_a_zero_stride_is_an_error() {
+        let pixels = [0u8; 64 * 48];
+        let frame = FrameView::packed(&pixels, 64, 48).unwrap();
+        let config = LikelihoodConfig::default();
+        let needed = EdgeMap::bytes_needed(64, 48, config.stride_px);
+        assert_eq!(needed, 16 * 12 * EDGE_BINS);
+        let mut small = [0u8; 100];
+        assert_eq!(
+            EdgeMap::build(&mut small, &frame, &config).err(),
+            Some(LikelihoodError::BufferTooSmall {
+                needed: needed as u32
+            })
+        );
+        let mut buffer = [0u8; 16 * 12 * EDGE_BINS];
+        let zero = LikelihoodConfig {
+            stride_px: 0,
+            ..config
+        };
+        assert_eq!(
+            EdgeMap::build(&mut buffer, &frame, &zero).err(),
+            Some(LikelihoodError::ZeroStride)
+        );
+        // A flat frame has no edges: every distance is the farthest.
+        let map = EdgeMap::build(&mut buffer, &frame, &config).unwrap();
+        assert_eq!(map.edge_cells, 0);
+        let far = map.distance_px(0, &Vector2::new(10.0, 10.0)).unwrap();
+        assert!(far > 300.0, "{far}");
+        assert_eq!(map.distance_px(0, &Vector2::new(-1.0, 10.0)), None);
+    }
+
+    #[test]
     fn bins_wrap_around_half_a_turn_and_name_the_next_nearest() {
         assert_eq!(bin_of(0.0).0, 0);
         assert_eq!(bin_of(PI).0, 0);

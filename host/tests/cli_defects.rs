@@ -315,3 +315,46 @@ fn a_closed_stdout_pipe_is_not_a_panic() {
     assert!(!err.contains("panicked"), "{err}");
     assert_ne!(out.status.code(), Some(101), "{err}");
 }
+
+#[test]
+fn one_board_per_camera_needs_as_many_ports_as_cameras_and_a_sequence() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = sequence(dir.path(), 2);
+    let seq = seq.to_str().unwrap();
+    // A one-camera sequence and two ports: refused before any port is opened.
+    let out = digiteyes(
+        &[
+            "stream",
+            "--port",
+            "/nonexistent/a",
+            "--port",
+            "/nonexistent/b",
+            "--seq",
+            seq,
+        ],
+        dir.path(),
+    );
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(
+        err.contains("1 camera(s) and 2 --port(s)") && err.contains("one board per camera"),
+        "{err}"
+    );
+    // Two ports without a sequence.
+    let out = digiteyes(
+        &[
+            "stream",
+            "--port",
+            "/nonexistent/a",
+            "--port",
+            "/nonexistent/b",
+            "--camera",
+            "/dev/null",
+            "--setup",
+            seq,
+        ],
+        dir.path(),
+    );
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("needs --seq DIR"), "{}", stderr(&out));
+}
