@@ -21,6 +21,7 @@
 //! - [`silhouette`]: how well the projected silhouette agrees with the image (region evidence).
 //! - [`likelihood`]: how well a hypothesised state explains a frame (oriented chamfer + silhouette).
 //! - [`acquire`]: the anytime coarse-to-fine search that finds the hand without help.
+//! - [`status`], [`auto_tracker`]: Searching → Tracking → Lost, around the search and the tracker.
 //! - [`search`]: one camera's slice search across a frame's iterations (coarse to fine).
 //! - [`measurer`]: where the loop's features come from: local frames, or one board per camera.
 //! - [`remote`]: a board's answer to a stereo host's `Measure`, and its features on the wire.
@@ -36,6 +37,7 @@
 #![warn(missing_docs)]
 
 pub mod acquire;
+pub mod auto_tracker;
 pub mod camera;
 pub mod config;
 pub mod estimator;
@@ -55,6 +57,7 @@ pub mod remote;
 pub mod search;
 pub mod silhouette;
 pub mod state;
+pub mod status;
 pub mod tracker;
 pub mod visibility;
 
