@@ -83,7 +83,14 @@ fn track(seq: &std::path::Path, k: u8, out: &std::path::Path) -> Result<Outcome>
             let model = multi.tracker().model();
             let cams = multi.tracker().cameras();
             let st = scorer.score(model, cams, &views, &maps, &t, &config.likelihood);
-            let sb = scorer.score(model, cams, &views, &maps, multi.state(), &config.likelihood);
+            let sb = scorer.score(
+                model,
+                cams,
+                &views,
+                &maps,
+                multi.state(),
+                &config.likelihood,
+            );
             margins.push(st - sb);
         }
     }
@@ -144,7 +151,11 @@ fn main() -> Result<()> {
     let mut table: Vec<Vec<(bool, Outcome)>> = ks.iter().map(|_| Vec::new()).collect();
     for seed in seeds {
         let stereo = seed % 2 == 0;
-        let name = if stereo { "random-stereo" } else { "random-mono" };
+        let name = if stereo {
+            "random-stereo"
+        } else {
+            "random-mono"
+        };
         let seq = dir.path().join(format!("seed{seed}"));
         render_scenario(
             name,

@@ -22,7 +22,8 @@ impl Fingers {
     pub fn of(model: &Model) -> Self {
         let mut of = [None; MAX_STATES];
         let mut roots: Vec<u8, MAX_FINGERS> = Vec::new();
-        for s in BASE_STATES..model.n_states().min(MAX_STATES) {
+        let n = model.n_states().min(MAX_STATES);
+        for (s, finger) in of.iter_mut().enumerate().take(n).skip(BASE_STATES) {
             let Some(root) = model
                 .joint_frame(s)
                 .and_then(|f| model.chain(f))
@@ -39,7 +40,7 @@ impl Fingers {
                     roots.len() - 1
                 }
             };
-            of[s] = Some(index as u8);
+            *finger = Some(index as u8);
         }
         Fingers {
             of,

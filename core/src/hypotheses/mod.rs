@@ -29,6 +29,7 @@ use heapless::Vec;
 pub use config::{HypothesesConfig, Spread};
 
 use crate::auto_tracker::AutoError;
+use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_CANDIDATES, MAX_HYPOTHESES};
 use crate::frame::FrameView;
 use crate::likelihood::EdgeMap;
@@ -118,6 +119,13 @@ impl MultiTracker {
         &self.config
     }
 
+    /// New cameras for the frames to come (the tracker's other parameters kept), for every
+    /// hypothesis.
+    pub fn reconfigure(&mut self, cameras: &[Camera]) -> Result<(), TrackerError> {
+        let config = *self.tracker.config();
+        self.tracker.reconfigure(cameras, config)
+    }
+
     /// Restarts from one hypothesis at `state`, forgetting the motion and the others.
     pub fn reset(&mut self, state: &[f32]) -> Result<(), TrackerError> {
         self.tracker.reset(state)?;
@@ -176,13 +184,22 @@ impl MultiTracker {
             let memory = self.tracker.memory();
             if index == 0 {
                 let spawn = self.config.spawn();
-                let directions = weak::weakest(
-                    self.tracker.normal_equations(),
-                    n,
-                    self.tracker.free(),
-                    &self.config.spread,
-                    spawn.div_ceil(2),
-                );
+                let normal = self.tracker.normal_equations();
+                let free = self.tracker.free();
+                let spread = &self.config.spread;
+                let mut directions: Vec<weak::WeakDirection, { crate::config::MAX_SPAWN }> =
+                    Vec::new();
+                if spawn > 0 {
+                    if let Some((_, d)) =
+                        weak::most_ambiguous_finger(normal, n, free, &self.fingers, spread)
+                    {
+                        let _ = directions.push(d);
+                    }
+                    let rest = spawn.div_ceil(2).saturating_sub(directions.len());
+                    for d in weak::weakest(normal, n, free, spread, rest) {
+                        let _ = directions.push(d);
+                    }
+                }
                 'sampling: for d in &directions {
                     for sign in [1.0f32, -1.0] {
                         if samples.len() >= spawn {
