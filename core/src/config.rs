@@ -19,3 +19,11 @@ pub const MAX_WINDOW: usize = 64;
 pub const MAX_CHAIN: usize = 8;
 /// Most non-zero entries in one residual row: 7 palm states plus a joint chain.
 pub const MAX_ROW_NONZEROS: usize = 7 + MAX_CHAIN;
+/// Most hypotheses a [`MultiTracker`](crate::hypotheses::MultiTracker) carries between frames.
+pub const MAX_HYPOTHESES: usize = 8;
+/// Most new hypotheses sampled on one frame.
+pub const MAX_SPAWN: usize = 4;
+/// Most hypotheses weighed on one frame: those carried, those sampled along weak directions,
+/// and the best with one finger (or all) kept where it was (`hypotheses::fingers`).
+pub const MAX_CANDIDATES: usize =
+    MAX_HYPOTHESES + MAX_SPAWN + crate::hypotheses::fingers::MAX_FINGERS + 1;

@@ -26,6 +26,7 @@
 //! - [`measurer`]: where the loop's features come from: local frames, or one board per camera.
 //! - [`remote`]: a board's answer to a stereo host's `Measure`, and its features on the wire.
 //! - [`tracker`]: the per-frame loop and its report.
+//! - [`hypotheses`]: several hypotheses through ambiguity, each refined by the loop.
 //! - [`measurement`]: measured axis lines and fingertips at a state, for a stereo host.
 //! - [`protocol`]: the board link's messages and their framing (`docs/protocol.md`).
 //!
@@ -43,6 +44,7 @@ pub mod config;
 pub mod estimator;
 pub mod features;
 pub mod frame;
+pub mod hypotheses;
 pub mod kinematics;
 pub mod likelihood;
 pub mod measurement;

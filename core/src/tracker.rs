@@ -163,6 +163,19 @@ struct Workspace {
     normal: NormalEquations,
 }
 
+/// What a [`Tracker`] knows of one hand between frames: the state, the motion the next
+/// prediction extrapolates, and the silhouette reference. Saved and restored to run one
+/// tracker for several hypotheses ([`crate::hypotheses`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackMemory {
+    /// The state estimate (quaternion, mm, rad).
+    pub state: Vec<f32, MAX_STATES>,
+    /// The change of each state over the last frame as trusted; `None` after a reset.
+    pub velocity: Option<[f32; MAX_STATES]>,
+    /// The silhouette agreement a right track has in these images.
+    pub silhouette_reference: Option<f32>,
+}
+
 /// Tracks one hand over frames from one or more calibrated cameras.
 #[derive(Debug, Clone)]
 pub struct Tracker {
@@ -252,6 +265,35 @@ impl Tracker {
         self.reset(state)?;
         self.silhouette_reference = None;
         Ok(())
+    }
+
+    /// What the tracker knows of the hand between frames.
+    pub fn memory(&self) -> TrackMemory {
+        TrackMemory {
+            state: self.state.clone(),
+            velocity: self.velocity,
+            silhouette_reference: self.silhouette_reference,
+        }
+    }
+
+    /// Puts back what [`Tracker::memory`] saved (of this tracker's model): the next frame
+    /// goes on from there as if nothing had run in between. A state of the wrong length or
+    /// one that cannot be posed is refused and nothing changes.
+    pub fn restore(&mut self, memory: &TrackMemory) -> Result<(), TrackerError> {
+        self.work
+            .poses
+            .update(&self.model, &memory.state)
+            .map_err(TrackerError::State)?;
+        self.state.clone_from(&memory.state);
+        self.velocity = memory.velocity;
+        self.silhouette_reference = memory.silhouette_reference;
+        Ok(())
+    }
+
+    /// The normal equations of the last iteration of the last frame (`JᵀWJ` with the prior,
+    /// without the conditioning): how well each direction of the state was observed.
+    pub fn normal_equations(&self) -> &NormalEquations {
+        &self.work.normal
     }
 
     /// The current state estimate (quaternion, mm, rad).

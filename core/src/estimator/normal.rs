@@ -170,6 +170,19 @@ impl NormalEquations {
         self.solve(n_states, free, conditioning, &rhs).map(|x| -x)
     }
 
+    /// Element (`si`, `sj`) of `JᵀWJ` by states (either order; 0 beyond [`MAX_STATES`]).
+    pub fn element(&self, si: usize, sj: usize) -> f32 {
+        if si >= MAX_STATES || sj >= MAX_STATES {
+            return 0.0;
+        }
+        let (pi, pj) = (position(si), position(sj));
+        match pi.cmp(&pj) {
+            core::cmp::Ordering::Equal => self.diag[pi],
+            core::cmp::Ordering::Greater => self.below(pi, pj),
+            core::cmp::Ordering::Less => self.below(pj, pi),
+        }
+    }
+
     /// `JᵀWJ · x` over the free states (zero for the others); `x` and the result by state.
     pub fn times(&self, free: FreeMask, x: &SVector<f32, MAX_STATES>) -> SVector<f32, MAX_STATES> {
         let mut y = SVector::<f32, MAX_STATES>::zeros();

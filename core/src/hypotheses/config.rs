@@ -1,0 +1,98 @@
+//! How many hypotheses, how they are sampled, merged and chosen.
+
+use crate::config::{MAX_HYPOTHESES, MAX_SPAWN};
+use crate::likelihood::LikelihoodConfig;
+use crate::state::StateKind;
+
+/// The size of a "unit" change of each kind of state: weak directions are found in these
+/// units (so millimetres and radians compare), samples step in them, and two hypotheses closer
+/// than [`HypothesesConfig::merge_distance`] of them in every state are one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Spread {
+    /// One quaternion component (unitless; 0.05 is about 6° of palm rotation).
+    pub quaternion: f32,
+    /// One translation state (mm).
+    pub translation_mm: f32,
+    /// One joint angle (rad).
+    pub joint_rad: f32,
+}
+
+impl Spread {
+    /// The unit of state `i`.
+    #[inline]
+    pub fn for_state(&self, i: usize) -> f32 {
+        StateKind::of(i).pick(self.quaternion, self.translation_mm, self.joint_rad)
+    }
+}
+
+impl Default for Spread {
+    fn default() -> Self {
+        Spread {
+            quaternion: 0.05,
+            translation_mm: 10.0,
+            joint_rad: 0.35,
+        }
+    }
+}
+
+/// Parameters of the multiple-hypothesis tracker.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct HypothesesConfig {
+    /// Hypotheses carried between frames, 1..=[`MAX_HYPOTHESES`] (1 is the single tracker,
+    /// bit for bit).
+    pub count: u8,
+    /// New hypotheses sampled per frame, 0..=[`MAX_SPAWN`]: pairs on either side of the best
+    /// along its weakest directions.
+    pub spawn_per_frame: u8,
+    /// Also weigh, every frame, the best with each finger's update undone (the finger where
+    /// it was on the last frame), and with every finger's undone: a finger the slices pulled
+    /// onto a neighbour's edges scores worse than where it was.
+    pub keep_fingers: bool,
+    /// Units of the state kinds.
+    pub spread: Spread,
+    /// How far a sample lies from the best along a weak direction (in [`Spread`] units).
+    pub spawn_step: f32,
+    /// Two hypotheses are one when no state differs by more than this (in [`Spread`] units).
+    pub merge_distance: f32,
+    /// Another hypothesis replaces the best only when it scores this much more (likelihood
+    /// units, 0..1): temporal consistency, so the output does not flicker between near ties.
+    pub switch_margin: f32,
+    /// Taken off the score of a hypothesis whose frame the tracker flagged lost.
+    pub lost_penalty: f32,
+    /// The image likelihood that scores them.
+    pub likelihood: LikelihoodConfig,
+}
+
+impl HypothesesConfig {
+    /// `count` clamped to 1..=[`MAX_HYPOTHESES`].
+    pub fn count(&self) -> usize {
+        usize::from(self.count).clamp(1, MAX_HYPOTHESES)
+    }
+
+    /// `spawn_per_frame` clamped to [`MAX_SPAWN`], and to 0 for a single hypothesis.
+    pub fn spawn(&self) -> usize {
+        if self.count() == 1 {
+            0
+        } else {
+            usize::from(self.spawn_per_frame).min(MAX_SPAWN)
+        }
+    }
+}
+
+impl Default for HypothesesConfig {
+    fn default() -> Self {
+        HypothesesConfig {
+            count: 1,
+            spawn_per_frame: 2,
+            keep_fingers: true,
+            spread: Spread::default(),
+            spawn_step: 1.0,
+            merge_distance: 0.3,
+            switch_margin: 0.01,
+            lost_penalty: 0.2,
+            likelihood: LikelihoodConfig::default(),
+        }
+    }
+}

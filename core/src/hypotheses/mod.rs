@@ -1,0 +1,326 @@
+//! Several hypotheses through ambiguity (after Cham & Rehg's multiple-hypothesis tracker).
+//!
+//! A single Gauss–Newton track commits to one reading of every frame; where the image is
+//! ambiguous (a finger seen end-on, fingers crossing, a palm's tilt weakly seen by one camera)
+//! it may commit to the wrong one and drift. Here up to [`HypothesesConfig::count`] states are
+//! carried between frames, each with its own motion. Every frame:
+//!
+//! 1. each hypothesis is tracked by the same Gauss–Newton loop (one [`Tracker`], its memory
+//!    swapped per hypothesis);
+//! 2. new hypotheses are sampled on either side of the best along the directions its normal
+//!    equations constrain least ([`weak`]), and refined by the loop on the same frame;
+//! 3. every hypothesis is scored by the image [likelihood](crate::likelihood), less a penalty
+//!    when the tracker flagged its frame lost;
+//! 4. near-duplicates are merged into the better ([`merge`]), the best `count` kept; the best
+//!    is the output, and a challenger replaces the previous best only when it scores
+//!    [`HypothesesConfig::switch_margin`] more.
+//!
+//! With one hypothesis nothing is sampled or scored: the output is the single tracker's, bit
+//! for bit. The edge maps the likelihood needs live in the caller's buffers, one per camera.
+
+pub mod config;
+pub mod fingers;
+pub mod merge;
+pub mod score;
+pub mod weak;
+
+use heapless::Vec;
+
+pub use config::{HypothesesConfig, Spread};
+
+use crate::auto_tracker::AutoError;
+use crate::camera::Camera;
+use crate::config::{MAX_CAMERAS, MAX_CANDIDATES, MAX_HYPOTHESES};
+use crate::frame::FrameView;
+use crate::likelihood::EdgeMap;
+use crate::state::{clamp_to_limit, renormalise_quaternion};
+use crate::tracker::{FrameReport, TrackMemory, Tracker, TrackerError};
+use score::StateScorer;
+
+/// One hypothesis: what the tracker knows of the hand under it, its last frame, its score.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Hypothesis {
+    /// The tracker's memory under this hypothesis (its state is the hypothesis).
+    pub memory: TrackMemory,
+    /// The tracker's report of its last frame.
+    pub report: FrameReport,
+    /// The likelihood score of its last frame, less the lost penalty (0 with one hypothesis).
+    pub score: f32,
+    /// Frames it has been carried (0 when sampled on this frame).
+    pub age: u32,
+}
+
+/// What one frame did.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MultiReport {
+    /// The best hypothesis' frame.
+    pub report: FrameReport,
+    /// The best hypothesis' score (0 with one hypothesis).
+    pub score: f32,
+    /// Hypotheses carried to the next frame.
+    pub count: u8,
+    /// Hypotheses sampled on this frame.
+    pub sampled: u8,
+    /// Candidates left out on this frame: merged into a better near-duplicate, or beyond
+    /// the count kept.
+    pub dropped: u8,
+    /// The best is not the previous frame's best.
+    pub switched: bool,
+}
+
+/// A tracker carrying several hypotheses.
+#[derive(Debug, Clone)]
+pub struct MultiTracker {
+    tracker: Tracker,
+    config: HypothesesConfig,
+    /// Best first; the tracker holds the best's memory between frames.
+    hypotheses: Vec<Hypothesis, MAX_HYPOTHESES>,
+    scorer: StateScorer,
+    fingers: fingers::Fingers,
+}
+
+impl MultiTracker {
+    /// Hypotheses around `tracker`, which starts as the only one.
+    pub fn new(tracker: Tracker, config: HypothesesConfig) -> Self {
+        let mut hypotheses = Vec::new();
+        let _ = hypotheses.push(Hypothesis {
+            memory: tracker.memory(),
+            report: FrameReport::default(),
+            score: 0.0,
+            age: 0,
+        });
+        let fingers = fingers::Fingers::of(tracker.model());
+        MultiTracker {
+            tracker,
+            config,
+            hypotheses,
+            scorer: StateScorer::new(),
+            fingers,
+        }
+    }
+
+    /// The hypotheses carried, best first.
+    pub fn hypotheses(&self) -> &[Hypothesis] {
+        &self.hypotheses
+    }
+
+    /// The tracker, holding the best hypothesis.
+    pub fn tracker(&self) -> &Tracker {
+        &self.tracker
+    }
+
+    /// The best state (quaternion, mm, rad).
+    pub fn state(&self) -> &[f32] {
+        self.tracker.state()
+    }
+
+    /// The parameters.
+    pub fn config(&self) -> &HypothesesConfig {
+        &self.config
+    }
+
+    /// New cameras for the frames to come (the tracker's other parameters kept), for every
+    /// hypothesis.
+    pub fn reconfigure(&mut self, cameras: &[Camera]) -> Result<(), TrackerError> {
+        let config = *self.tracker.config();
+        self.tracker.reconfigure(cameras, config)
+    }
+
+    /// Restarts from one hypothesis at `state`, forgetting the motion and the others.
+    pub fn reset(&mut self, state: &[f32]) -> Result<(), TrackerError> {
+        self.tracker.reset(state)?;
+        self.hypotheses.clear();
+        let _ = self.hypotheses.push(Hypothesis {
+            memory: self.tracker.memory(),
+            report: FrameReport::default(),
+            score: 0.0,
+            age: 0,
+        });
+        Ok(())
+    }
+
+    /// One instant: `frames[i]` is camera `i`'s, `edge_buffers[i]` its edge map's buffer
+    /// (unused, and may be empty, with one hypothesis).
+    pub fn track(
+        &mut self,
+        frames: &[FrameView<'_>],
+        edge_buffers: &mut [&mut [u8]],
+    ) -> Result<MultiReport, AutoError> {
+        if self.config.count() == 1 {
+            let report = self.tracker.track(frames)?;
+            if let Some(h) = self.hypotheses.first_mut() {
+                h.memory = self.tracker.memory();
+                h.report = report;
+                h.age += 1;
+            }
+            return Ok(MultiReport {
+                report,
+                count: 1,
+                ..MultiReport::default()
+            });
+        }
+        if frames.len() != self.tracker.cameras().len() {
+            return Err(AutoError::Tracker(TrackerError::FrameCount));
+        }
+        if edge_buffers.len() < frames.len() {
+            return Err(AutoError::BufferCount);
+        }
+        let likelihood = self.config.likelihood;
+        let mut maps: Vec<EdgeMap<'_>, MAX_CAMERAS> = Vec::new();
+        for (buffer, frame) in edge_buffers.iter_mut().zip(frames) {
+            let map = EdgeMap::build(buffer, frame, &likelihood).map_err(AutoError::EdgeMap)?;
+            if maps.push(map).is_err() {
+                return Err(AutoError::Tracker(TrackerError::CameraCount));
+            }
+        }
+        let mut candidates: Vec<Hypothesis, MAX_CANDIDATES> = Vec::new();
+        let n = self.tracker.model().n_states();
+        let mut samples = Vec::<TrackMemory, { crate::config::MAX_SPAWN }>::new();
+        let mut undone = Vec::<Hypothesis, { fingers::MAX_FINGERS + 1 }>::new();
+        // 1. Every hypothesis through the loop; the weak directions of the best.
+        for (index, h) in self.hypotheses.iter().enumerate() {
+            self.tracker.restore(&h.memory)?;
+            let report = self.tracker.track(frames)?;
+            let memory = self.tracker.memory();
+            if index == 0 {
+                let spawn = self.config.spawn();
+                let normal = self.tracker.normal_equations();
+                let free = self.tracker.free();
+                let spread = &self.config.spread;
+                let mut directions: Vec<weak::WeakDirection, { crate::config::MAX_SPAWN }> =
+                    Vec::new();
+                if spawn > 0 {
+                    if let Some((_, d)) =
+                        weak::most_ambiguous_finger(normal, n, free, &self.fingers, spread)
+                    {
+                        let _ = directions.push(d);
+                    }
+                    let rest = spawn.div_ceil(2).saturating_sub(directions.len());
+                    for d in weak::weakest(normal, n, free, spread, rest) {
+                        let _ = directions.push(d);
+                    }
+                }
+                'sampling: for d in &directions {
+                    for sign in [1.0f32, -1.0] {
+                        if samples.len() >= spawn {
+                            break 'sampling;
+                        }
+                        let mut sample = memory.clone();
+                        for (i, v) in sample.state.iter_mut().enumerate() {
+                            let moved = *v + sign * self.config.spawn_step * d.direction[i];
+                            *v = clamp_to_limit(self.tracker.model(), i, moved);
+                        }
+                        renormalise_quaternion(&mut sample.state);
+                        sample.velocity = None;
+                        let _ = samples.push(sample);
+                    }
+                }
+            }
+            let kept_fingers = if index == 0 && self.config.keep_fingers {
+                self.fingers.count() + 1
+            } else {
+                0
+            };
+            for f in 0..kept_fingers {
+                // Finger `f` (or every finger, for f == count) back where it was.
+                let mut kept = memory.clone();
+                for s in 0..n {
+                    let undo = if f == self.fingers.count() {
+                        s >= crate::model::BASE_STATES
+                    } else {
+                        self.fingers.contains(f, s)
+                    };
+                    if undo {
+                        kept.state[s] = h.memory.state[s];
+                        if let Some(v) = kept.velocity.as_mut() {
+                            v[s] = 0.0;
+                        }
+                    }
+                }
+                let _ = undone.push(Hypothesis {
+                    memory: kept,
+                    report,
+                    score: 0.0,
+                    age: 0,
+                });
+            }
+            let _ = candidates.push(Hypothesis {
+                memory,
+                report,
+                score: 0.0,
+                age: h.age + 1,
+            });
+        }
+        for u in undone {
+            let _ = candidates.push(u);
+        }
+        // 2. The samples refined on this frame, carrying on with the best's motion.
+        let parent_velocity = candidates.first().and_then(|c| c.memory.velocity);
+        let mut sampled = 0u8;
+        for sample in &samples {
+            if self.tracker.restore(sample).is_err() {
+                continue;
+            }
+            let report = self.tracker.track(frames)?;
+            let mut memory = self.tracker.memory();
+            memory.velocity = parent_velocity;
+            sampled += 1;
+            let _ = candidates.push(Hypothesis {
+                memory,
+                report,
+                score: 0.0,
+                age: 0,
+            });
+        }
+        // 3. Scores.
+        for c in candidates.iter_mut() {
+            let mut score = self.scorer.score(
+                self.tracker.model(),
+                self.tracker.cameras(),
+                frames,
+                &maps,
+                &c.memory.state,
+                &likelihood,
+            );
+            if c.report.lost {
+                score -= self.config.lost_penalty;
+            }
+            c.score = score;
+        }
+        // 4. Merge and keep; the previous best keeps its place unless clearly beaten.
+        let mut ranking = [0.0f32; MAX_CANDIDATES];
+        for (r, c) in ranking.iter_mut().zip(&candidates) {
+            *r = c.score;
+        }
+        if let Some(r) = ranking.first_mut() {
+            *r += self.config.switch_margin;
+        }
+        let mut order = [0usize; MAX_CANDIDATES];
+        let mut kept = merge::pick(
+            &ranking[..candidates.len()],
+            |i| &candidates[i].memory.state[..],
+            &self.config.spread,
+            self.config.merge_distance,
+            self.config.count(),
+            &mut order,
+        );
+        if kept == 0 {
+            kept = 1; // cannot happen (one is always kept), but the previous best stays
+            order[0] = 0;
+        }
+        self.hypotheses.clear();
+        for &i in &order[..kept] {
+            let _ = self.hypotheses.push(candidates[i].clone());
+        }
+        let best = &candidates[order[0]];
+        self.tracker.restore(&best.memory)?;
+        Ok(MultiReport {
+            report: best.report,
+            score: best.score,
+            count: kept as u8,
+            sampled,
+            dropped: (candidates.len() - kept).min(usize::from(u8::MAX)) as u8,
+            switched: order[0] != 0,
+        })
+    }
+}

@@ -1,0 +1,67 @@
+//! Tracks a rendered sequence with K hypotheses, for counting instructions per frame under
+//! callgrind (`scripts/hypotheses-instructions` collects only `MultiTracker::track`).
+//!
+//! `cargo run --release -p digiteyes-tests --example hypotheses_cost -- SEQ K FRAMES`
+
+use anyhow::{Context, Result};
+use digiteyes_core::frame::FrameView;
+use digiteyes_core::hypotheses::{HypothesesConfig, MultiTracker};
+use digiteyes_core::likelihood::EdgeMap;
+use digiteyes_host::sequence::Sequence;
+use digiteyes_host::track::sequence_tracker;
+use digiteyes_host::TrackerConfig;
+
+fn main() -> Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let seq = args.first().context("SEQ K FRAMES")?;
+    let k: u8 = args.get(1).context("SEQ K FRAMES")?.parse()?;
+    let frames: usize = args.get(2).context("SEQ K FRAMES")?.parse()?;
+    let sequence = Sequence::open(std::path::Path::new(seq))?;
+    let config = HypothesesConfig {
+        count: k,
+        ..HypothesesConfig::default()
+    };
+    let tracker = sequence_tracker(&sequence, TrackerConfig::default())
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mut multi = MultiTracker::new(tracker, config);
+    let mut buffers: Vec<Vec<u8>> = sequence
+        .cameras
+        .iter()
+        .map(|c| {
+            let n = EdgeMap::bytes_needed(
+                c.width as usize,
+                c.height as usize,
+                config.likelihood.stride_px,
+            );
+            vec![0u8; n]
+        })
+        .collect();
+    let images: Vec<Vec<_>> = (0..frames.min(sequence.frames))
+        .map(|f| {
+            (0..sequence.cameras.len())
+                .map(|c| sequence.read_frame(c, f))
+                .collect::<Result<Vec<_>>>()
+        })
+        .collect::<Result<_>>()?;
+    let (mut hypotheses, mut sampled) = (0usize, 0usize);
+    for frame in &images {
+        let views = frame
+            .iter()
+            .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        let mut slices: Vec<&mut [u8]> = buffers.iter_mut().map(|b| b.as_mut_slice()).collect();
+        let report = multi
+            .track(&views, &mut slices)
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        hypotheses += usize::from(report.count);
+        sampled += usize::from(report.sampled);
+    }
+    println!(
+        "K={k}: {} frames, {:.2} hypotheses carried and {:.2} sampled per frame",
+        images.len(),
+        hypotheses as f64 / images.len().max(1) as f64,
+        sampled as f64 / images.len().max(1) as f64
+    );
+    Ok(())
+}
