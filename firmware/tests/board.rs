@@ -27,6 +27,7 @@ fn configure(stats_every: u16, features_every: u16) -> HostMessage<'static> {
         tracker: TrackerParams::default(),
         features_every,
         stats_every,
+        search_evaluations_per_frame: default_search_evaluations(),
     })
 }
 
@@ -34,6 +35,7 @@ fn reset(q: &[f32]) -> HostMessage<'static> {
     HostMessage::Reset(Reset {
         q: q.iter().copied().collect(),
         free: free_mask(),
+        start: Start::Given,
     })
 }
 
@@ -334,6 +336,7 @@ fn bad_commands_are_refused_and_change_nothing() {
         tracker: params,
         features_every: 0,
         stats_every: 0,
+        search_evaluations_per_frame: default_search_evaluations(),
     }));
     params.iterations = 0;
     pipe.send(&HostMessage::Configure(Configure {
@@ -341,6 +344,7 @@ fn bad_commands_are_refused_and_change_nothing() {
         tracker: params,
         features_every: 0,
         stats_every: 0,
+        search_evaluations_per_frame: default_search_evaluations(),
     }));
     let mut big = good_cam;
     big.width *= 2;
@@ -349,11 +353,13 @@ fn bad_commands_are_refused_and_change_nothing() {
         tracker: TrackerParams::default(),
         features_every: 0,
         stats_every: 0,
+        search_evaluations_per_frame: default_search_evaluations(),
     }));
     pipe.send(&configure(0, 0));
     pipe.send(&HostMessage::Reset(Reset {
         q: q0[..7].iter().copied().collect(),
         free: free_mask(),
+        start: Start::Given,
     }));
     let mut nan = q0.clone();
     nan[9] = f32::NAN;
@@ -361,6 +367,7 @@ fn bad_commands_are_refused_and_change_nothing() {
     pipe.send(&HostMessage::Reset(Reset {
         q: q0.iter().copied().collect(),
         free: 1 << 30,
+        start: Start::Given,
     }));
     board.poll().unwrap();
     let got = board.serial_mut().received();
@@ -424,10 +431,7 @@ fn a_camera_source_is_tracked_without_uploads() {
         next: 0,
     };
     let mut buffer = vec![0u8; FRAME_BYTES];
-    let mut board = Board::new(
-        "cam",
-        &mut buffer,
-        None,
+    let mut board = Board::new("cam", buffers(&mut buffer, None),
         Pipe::default(),
         source,
         NoLed,
@@ -507,10 +511,7 @@ fn the_overlay_draws_the_model_over_the_dimmed_frame() {
     let pixels = render(&model, &cam, &q0);
     let mut buffer = vec![0u8; FRAME_BYTES];
     let mut overlay = vec![0u8; FRAME_BYTES];
-    let mut board = Board::new(
-        "t",
-        &mut buffer,
-        Some(&mut overlay),
+    let mut board = Board::new("t", buffers(&mut buffer, Some(&mut overlay)),
         Pipe::default(),
         Uploads,
         NoLed,
