@@ -123,6 +123,11 @@ fn uploaded_frames_give_the_in_process_trackers_states() {
             )
         );
         assert!(state.track_ticks > 0);
+        assert_eq!(
+            (state.status, state.search_evaluations),
+            (WireStatus::Tracking, 0),
+            "a board reset from a given state tracks"
+        );
         assert!(
             report.features_found > 0,
             "the synthetic frame shows the hand"

@@ -11,7 +11,8 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
-use digiteyes_core::protocol::{BoardMessage, LinkCounters};
+use digiteyes_core::protocol::{BoardMessage, LinkCounters, WireStatus};
+use digiteyes_core::status::Status;
 
 use crate::forward::one_euro::Smoothing;
 use crate::forward::{Forward, ForwardOptions, Forwarder};
@@ -45,6 +46,9 @@ pub struct ListenSummary {
     pub messages: usize,
     /// `State`s among them.
     pub states: usize,
+    /// Those states by the board's status: searching, tracking, lost ([`Status::ALL`]'s
+    /// order).
+    pub statuses: [usize; 3],
     /// Datagrams forwarded (to all targets).
     pub forwarded: usize,
     /// The host receiver's counters.
@@ -98,7 +102,13 @@ pub fn listen(link: Link, options: &ListenOptions, out: &mut dyn Write) -> Resul
         };
         let received = Instant::now();
         summary.messages += 1;
-        summary.states += usize::from(matches!(message, BoardMessage::State(_)));
+        if let BoardMessage::State(state) = &message {
+            summary.states += 1;
+            let status = Status::from(state.status);
+            if let Some(i) = Status::ALL.iter().position(|&s| s == status) {
+                summary.statuses[i] += 1;
+            }
+        }
         if options.json {
             writeln!(out, "{}", serde_json::to_string(&message)?)?;
         } else {
@@ -129,9 +139,15 @@ pub fn describe(message: &BoardMessage) -> String {
         ),
         BoardMessage::State(s) => {
             let q: Vec<String> = s.q.iter().map(|v| format!("{v:.4}")).collect();
+            let search = match s.status {
+                WireStatus::Searching => format!(" ({} evaluations)", s.search_evaluations),
+                WireStatus::Tracking | WireStatus::Lost => String::new(),
+            };
             format!(
-                "state {}: rms {:.3} px, {}/{} features, {} iterations, {} ticks{} q=[{}]",
+                "state {} {}{search}: rms {:.3} px, {}/{} features, {} iterations, {} ticks{} \
+                 q=[{}]",
                 s.frame,
+                Status::from(s.status),
                 s.rms_px,
                 s.features_found,
                 s.features_expected,
@@ -221,6 +237,8 @@ mod tests {
                 features_expected: 24,
                 iterations: 5,
                 track_ticks: 1234,
+                status: WireStatus::Tracking,
+                search_evaluations: 0,
             });
             let mut buf = [0u8; MAX_MESSAGE];
             bytes.extend_from_slice(encode(&message, &mut buf).unwrap());

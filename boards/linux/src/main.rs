@@ -82,10 +82,14 @@ fn run(args: Args) -> Result<()> {
             None => "host uploads".to_string(),
         }
     );
+    let mut edge_map = vec![0u8; edge_map_bytes(width as usize, height as usize)];
     let mut board = Board::new(
         BOARD_NAME,
-        &mut frame_buffer,
-        None,
+        Buffers {
+            frame: &mut frame_buffer,
+            overlay: None,
+            edge_map: &mut edge_map,
+        },
         serial,
         source,
         led,

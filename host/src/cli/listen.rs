@@ -15,7 +15,9 @@ use crate::stream::DEFAULT_BAUD;
 /// Print what a board sends (states, drops, counters) and forward it over UDP.
 ///
 /// Decodes every message on the serial port and prints one line each: text by default,
-/// JSON with --json (e.g. {"State":{"frame":12,"timestamp":…,"q":[…],"rms_px":…,…}}).
+/// JSON with --json (e.g. {"State":{"frame":12,"timestamp":…,"q":[…],"rms_px":…,…,
+/// "status":"Tracking",…}}). Each state's line names the board's status (searching,
+/// tracking or lost); the summary on stderr counts them.
 /// With --forward, messages also go to the machines that show the hand, as JSON lines
 /// (udp://) or Open Sound Control (osc://: /digiteyes/state, /digiteyes/q/N,
 /// /digiteyes/mouse, /digiteyes/dropped, /digiteyes/stats; see docs/forwarding.md).
@@ -118,8 +120,10 @@ pub fn run(args: ListenArgs) -> Result<()> {
     let link = Link::open(&port.port, port.baud)?;
     eprintln!("listening on {}", port.port);
     let summary = listen(link, &options, &mut std::io::stdout().lock())?;
+    let [searching, tracking, lost] = summary.statuses;
     eprintln!(
-        "{} messages ({} states), {} forwarded; {} CRC errors, {} framing errors",
+        "{} messages ({} states: {tracking} tracking, {lost} lost, {searching} searching), {} \
+         forwarded; {} CRC errors, {} framing errors",
         summary.messages,
         summary.states,
         summary.forwarded,
