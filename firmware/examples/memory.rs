@@ -3,10 +3,10 @@
 
 use core::mem::size_of;
 
-use digiteyes_core::model::Model;
-use digiteyes_core::protocol::{Decoder, MAX_MESSAGE};
 use digiteyes_core::acquire::Acquirer;
 use digiteyes_core::auto_tracker::AutoTracker;
+use digiteyes_core::model::Model;
+use digiteyes_core::protocol::{Decoder, MAX_MESSAGE};
 use digiteyes_core::tracker::Tracker;
 use digiteyes_firmware::{edge_map_bytes, Board, Clock, NoLed, Uploads};
 

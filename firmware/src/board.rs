@@ -335,9 +335,9 @@ where
         {
             return Err(Refusal::FrameTooLarge);
         }
-        let unchanged = self.setup.is_some_and(|s| {
-            s.camera == camera && s.config == config && s.acquire == acquire
-        });
+        let unchanged = self
+            .setup
+            .is_some_and(|s| s.camera == camera && s.config == config && s.acquire == acquire);
         if !unchanged {
             if let Some(auto) = self.tracker.take() {
                 // Keep the state, the free states and the status with the new camera and

@@ -436,7 +436,9 @@ fn a_camera_source_is_tracked_without_uploads() {
         next: 0,
     };
     let mut buffer = vec![0u8; FRAME_BYTES];
-    let mut board = Board::new("cam", buffers(&mut buffer, None),
+    let mut board = Board::new(
+        "cam",
+        buffers(&mut buffer, None),
         Pipe::default(),
         source,
         NoLed,
@@ -516,7 +518,9 @@ fn the_overlay_draws_the_model_over_the_dimmed_frame() {
     let pixels = render(&model, &cam, &q0);
     let mut buffer = vec![0u8; FRAME_BYTES];
     let mut overlay = vec![0u8; FRAME_BYTES];
-    let mut board = Board::new("t", buffers(&mut buffer, Some(&mut overlay)),
+    let mut board = Board::new(
+        "t",
+        buffers(&mut buffer, Some(&mut overlay)),
         Pipe::default(),
         Uploads,
         NoLed,

@@ -152,7 +152,10 @@ fn a_tracking_board_reports_tracking_then_lost_then_searching() {
         assert!(state.lost, "frame {n}: the hand is gone");
         let status = Status::from(state.status);
         if status != Status::Searching {
-            assert_eq!(state.search_evaluations, 0, "frame {n}: no search while {status}");
+            assert_eq!(
+                state.search_evaluations, 0,
+                "frame {n}: no search while {status}"
+            );
         }
         statuses.push(status);
         n += 1;
@@ -171,10 +174,10 @@ fn configure_refuses_a_zero_budget_and_an_edge_map_that_does_not_fit() {
     board.start().unwrap();
     board.serial_mut().send(&configure(8, 0));
     board.poll().unwrap();
-    assert!(board
-        .serial_mut()
-        .received()
-        .ends_with(&[BoardMessage::Nak(Command::Configure, Refusal::BadParameters)]));
+    assert!(board.serial_mut().received().ends_with(&[BoardMessage::Nak(
+        Command::Configure,
+        Refusal::BadParameters
+    )]));
 
     // The frame fits the frame buffer; its edge map does not fit the edge-map buffer.
     let mut frame = vec![0u8; FRAME_BYTES];
@@ -194,10 +197,10 @@ fn configure_refuses_a_zero_budget_and_an_edge_map_that_does_not_fit() {
     small.start().unwrap();
     small.serial_mut().send(&configure(8, BUDGET));
     small.poll().unwrap();
-    assert!(small
-        .serial_mut()
-        .received()
-        .ends_with(&[BoardMessage::Nak(Command::Configure, Refusal::FrameTooLarge)]));
+    assert!(small.serial_mut().received().ends_with(&[BoardMessage::Nak(
+        Command::Configure,
+        Refusal::FrameTooLarge
+    )]));
 }
 
 /// A second `Configure` that changes the parameters keeps the status and the state: a

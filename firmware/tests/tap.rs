@@ -28,7 +28,9 @@ fn the_tap_sees_every_frame_of_a_pass_with_its_pixels_and_state() {
             t.camera.width,
         ))
     };
-    let mut board = Board::new("test", buffers(&mut buffer, None),
+    let mut board = Board::new(
+        "test",
+        buffers(&mut buffer, None),
         Pipe::default(),
         Uploads,
         NoLed,

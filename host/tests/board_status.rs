@@ -36,7 +36,11 @@ fn state(frame: u32, status: WireStatus) -> BoardMessage {
         iterations: 5,
         track_ticks: 1234,
         status,
-        search_evaluations: if status == WireStatus::Searching { 977 } else { 0 },
+        search_evaluations: if status == WireStatus::Searching {
+            977
+        } else {
+            0
+        },
     })
 }
 
@@ -79,7 +83,10 @@ fn listen_prints_each_states_status_and_counts_them() {
 
     let deadline = Instant::now() + Duration::from_secs(30);
     while listen.0.try_wait().unwrap().is_none() {
-        assert!(Instant::now() < deadline, "listen did not stop after 4 states");
+        assert!(
+            Instant::now() < deadline,
+            "listen did not stop after 4 states"
+        );
         // Polling for the child's exit, which it reaches by itself after four states.
         std::thread::sleep(Duration::from_millis(10));
     }
@@ -119,7 +126,9 @@ fn stream_init_auto_has_a_simulated_board_search_and_writes_the_status() {
     let board = sim::start(SimOptions::default()).unwrap();
     let port = board.path().display().to_string();
     let out = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
-        .args(["stream", "--port", &port, "--seq", "mouse", "--init", "auto"])
+        .args([
+            "stream", "--port", &port, "--seq", "mouse", "--init", "auto",
+        ])
         .args(["--out", "s.csv", "--quiet"])
         .current_dir(dir.path())
         .output()
@@ -144,7 +153,10 @@ fn stream_init_auto_has_a_simulated_board_search_and_writes_the_status() {
         let tail = &row[row.len() - 3..];
         assert_eq!(tail[0] == "1", tail[2] != "tracking", "{row:?}");
     }
-    let searching = rows.iter().filter(|r| r.last() == Some(&"searching")).count();
+    let searching = rows
+        .iter()
+        .filter(|r| r.last() == Some(&"searching"))
+        .count();
     assert!(
         stdout.contains(&format!("{searching} searching")),
         "the summary counts the statuses: {stdout}"
@@ -160,7 +172,11 @@ fn stream_init_auto_has_a_simulated_board_search_and_writes_the_status() {
         .output()
         .unwrap();
     board.stop().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let csv = std::fs::read_to_string(dir.path().join("given.csv")).unwrap();
     assert!(
         csv.lines().skip(1).all(|l| l.ends_with(",0,,tracking")),

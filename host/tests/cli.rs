@@ -296,7 +296,11 @@ fn sim_then_stream_then_eval_from_the_command_line() {
     );
     let states = std::fs::read_to_string(dir.path().join("s.csv")).unwrap();
     assert!(
-        states.lines().next().unwrap().ends_with(",lost,dropped,status"),
+        states
+            .lines()
+            .next()
+            .unwrap()
+            .ends_with(",lost,dropped,status"),
         "{states}"
     );
     assert_eq!(states.lines().count(), 4);

@@ -6,8 +6,8 @@
 
 use digiteyes_core::model::Model;
 use digiteyes_core::protocol::{
-    encode, BoardMessage, DropReason, Dropped, FrameChunk, HostMessage, State, Stats, WireStatus, MAX_CHUNK,
-    MAX_MESSAGE,
+    encode, BoardMessage, DropReason, Dropped, FrameChunk, HostMessage, State, Stats, WireStatus,
+    MAX_CHUNK, MAX_MESSAGE,
 };
 
 const BAUDS: [u32; 2] = [115_200, 921_600];

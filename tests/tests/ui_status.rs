@@ -85,7 +85,11 @@ fn state(frame: u32, q: &[f32], status: WireStatus) -> BoardMessage {
         iterations: 3,
         track_ticks: 5000,
         status,
-        search_evaluations: if status == WireStatus::Searching { 900 } else { 0 },
+        search_evaluations: if status == WireStatus::Searching {
+            900
+        } else {
+            0
+        },
     })
 }
 
@@ -165,7 +169,13 @@ fn the_page_shows_each_status_and_draws_the_hand_accordingly() {
     for (status, word, text, hand, shapes) in [
         (WireStatus::Tracking, "tracking", "TRACKING", "solid", "16"),
         (WireStatus::Lost, "lost", "LOST TRACK", "ghost", "16"),
-        (WireStatus::Searching, "searching", "SEARCHING", "hidden", "0"),
+        (
+            WireStatus::Searching,
+            "searching",
+            "SEARCHING",
+            "hidden",
+            "0",
+        ),
     ] {
         let dom = page_with(&exe, status);
         assert_eq!(badge(&dom), text, "{word}:\n{dom}");

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::Parser;
 use digiteyes_board_linux::{Source, StatusLed, BOARD_NAME};
-use digiteyes_firmware::{Board, NoLed, Uploads};
+use digiteyes_firmware::{edge_map_bytes, Board, Buffers, NoLed, Uploads};
 use digiteyes_platform_linux::camera::V4l2Camera;
 use digiteyes_platform_linux::{parse_frame_size, MonotonicClock, TtySerial};
 use linux_embedded_hal::Delay;

@@ -73,6 +73,11 @@ pub struct StreamArgs {
     /// kept). One board per camera (the host's own tracker) supports `given` only.
     #[arg(long, value_enum, default_value_t = InitArg::Given)]
     pub init: InitArg,
+    /// The board's search budget: evaluations per frame at most while it searches, 1 to
+    /// 65535 (default: the search's, 1000). Lower keeps a searching frame's time nearer a
+    /// tracking frame's; the search then takes more frames.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub search_evaluations: Option<u16>,
     /// Output CSV path (default: states.csv in the current folder).
     #[arg(long, short, default_value = "states.csv", hide_default_value = true)]
     pub out: PathBuf,
@@ -161,6 +166,9 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
         .start(args.init.into())
         .progress(progress && !args.quiet);
     options.tracker = tracker;
+    if let Some(n) = args.search_evaluations {
+        options.search_evaluations_per_frame = n;
+    }
     let summary = match (args.seq, args.camera, args.setup) {
         (Some(seq), None, _) => stream_sequence(&seq, &args.out, &options)?,
         (None, Some(camera), Some(setup)) => {

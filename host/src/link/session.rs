@@ -381,9 +381,7 @@ impl Session {
 fn refusal_text(refusal: Refusal) -> &'static str {
     match refusal {
         Refusal::BadCamera => "the camera is unusable (size or focal length)",
-        Refusal::BadParameters => {
-            "a tracker parameter is out of range, or the search budget is 0"
-        }
+        Refusal::BadParameters => "a tracker parameter is out of range, or the search budget is 0",
         Refusal::FrameTooLarge => {
             "the camera's frames (or their edge map for the search) do not fit the board's \
              buffers"

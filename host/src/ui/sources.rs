@@ -282,7 +282,12 @@ mod tests {
         let lost = [0.0, 1.0, 1.0, 0.0];
         assert_eq!(
             replay_statuses(None, &lost).unwrap(),
-            [Status::Tracking, Status::Lost, Status::Lost, Status::Tracking]
+            [
+                Status::Tracking,
+                Status::Lost,
+                Status::Lost,
+                Status::Tracking
+            ]
         );
         let words = ["tracking", "lost", "searching", ""];
         assert_eq!(
