@@ -11,12 +11,12 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
-use digiteyes_core::protocol::{BoardMessage, LinkCounters, WireStatus};
+use digiteyes_core::protocol::{BoardMessage, LinkCounters, Start, WireStatus};
 use digiteyes_core::status::Status;
 
 use crate::forward::one_euro::Smoothing;
 use crate::forward::{Forward, ForwardOptions, Forwarder};
-use crate::link::{set_up_board, DropCause, Link};
+use crate::link::{set_up_board_starting, DropCause, Link};
 
 /// What to listen for and where it goes.
 #[derive(Debug, Clone, Default)]
@@ -37,6 +37,8 @@ pub struct ListenOptions {
     pub setup: Option<PathBuf>,
     /// The camera of a multi-camera setup.
     pub camera_index: Option<usize>,
+    /// With `setup`: how the board starts, from the initial state or searching.
+    pub start: Option<Start>,
 }
 
 /// What a listen session saw.
@@ -70,7 +72,8 @@ pub fn listen(link: Link, options: &ListenOptions, out: &mut dyn Write) -> Resul
     };
     let mut link = match &options.setup {
         Some(path) => {
-            let board = set_up_board(link, path, options.camera_index, out)?;
+            let start = options.start.unwrap_or(Start::Given);
+            let board = set_up_board_starting(link, path, options.camera_index, start, out)?;
             let (link, hello) = (board.link, board.hello);
             let initial_state: Vec<f32> = board
                 .sequence

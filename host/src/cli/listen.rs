@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args;
 
+use super::stream::InitArg;
 use crate::cli_values;
 use crate::forward::one_euro::{self, Smoothing};
 use crate::forward::parse_forward;
@@ -65,6 +66,10 @@ pub struct ListenArgs {
     /// folder: camera calibration, initial state, free states.
     #[arg(long, value_name = "PATH")]
     pub setup: Option<PathBuf>,
+    /// With --setup: how the board starts: `given` tracks from initial_state; `auto`
+    /// searches for the hand (the free states' initial values ignored, the fixed ones kept).
+    #[arg(long, value_enum, requires = "setup", default_value_t = InitArg::Given)]
+    pub init: InitArg,
     /// With --setup: the camera of a multi-camera description (0-based).
     #[arg(long, value_name = "N")]
     pub camera_index: Option<usize>,
@@ -114,6 +119,7 @@ pub fn run(args: ListenArgs) -> Result<()> {
         },
         setup: args.setup,
         camera_index: args.camera_index,
+        start: Some(args.init.into()),
         states: args.states,
         duration: args.seconds.map(cli_values::duration),
     };

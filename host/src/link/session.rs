@@ -421,12 +421,25 @@ pub struct SetUpBoard {
 }
 
 /// Configures and resets the board on `link` from `path` (a `sequence.json`, or a sequence
-/// folder holding one), for camera `camera` of a multi-camera description; says so on `out`.
-/// For a board with its own camera: `listen --setup`, `ui --port --setup`.
+/// folder holding one), for camera `camera` of a multi-camera description, tracking from the
+/// initial state; says so on `out`. For a board with its own camera: `listen --setup`,
+/// `ui --port --setup`.
 pub fn set_up_board(
     link: Link,
     path: &Path,
     camera: Option<usize>,
+    out: &mut dyn Write,
+) -> Result<SetUpBoard> {
+    set_up_board_starting(link, path, camera, Start::Given, out)
+}
+
+/// [`set_up_board`], starting as `start` says: from the initial state, or searching for the
+/// hand (`listen --setup … --init auto`).
+pub fn set_up_board_starting(
+    link: Link,
+    path: &Path,
+    camera: Option<usize>,
+    start: Start,
     out: &mut dyn Write,
 ) -> Result<SetUpBoard> {
     let json = if path.is_dir() {
@@ -435,7 +448,9 @@ pub fn set_up_board(
         path.to_path_buf()
     };
     let sequence = Sequence::open_description(&json)?;
-    let session = Session::start(link, SessionSetup::from_sequence(&sequence, camera)?)?;
+    let mut setup = SessionSetup::from_sequence(&sequence, camera)?;
+    setup.start = start;
+    let session = Session::start(link, setup)?;
     writeln!(
         out,
         "board {} set up from {}",
