@@ -17,6 +17,7 @@ use super::hub::{CameraFrame, Hub, ShownState};
 use crate::link::Link;
 use crate::sequence::states::read_states_with_gaps;
 use crate::sequence::Sequence;
+use crate::stream::STATUS_COLUMN;
 
 /// Longest UDP datagram read (a `Features` message as JSON is a few KB).
 const MAX_DATAGRAM: usize = 65_536;
@@ -228,9 +229,6 @@ impl Replay {
         Ok(())
     }
 }
-
-/// The column of a states CSV that names each frame's status (`track`'s and `stream`'s).
-pub const STATUS_COLUMN: &str = "status";
 
 /// Each frame's status: from the `status` column's words when the CSV has one, else from the
 /// `lost` column (a CSV written before the status existed: `lost` 1 → lost, else tracking).
