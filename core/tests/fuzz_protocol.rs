@@ -27,7 +27,7 @@ fn frame_of(message: &HostMessage) -> Vec<u8> {
 enum Owned {
     Ping(u32),
     Chunk(u32, u16, u16, u32, Vec<u8>),
-    Reset(Vec<f32>, u32),
+    Reset(Vec<f32>, u32, bool),
 }
 
 impl Owned {
@@ -43,9 +43,10 @@ impl Owned {
                     data,
                 })
             }
-            Owned::Reset(q, free) => HostMessage::Reset(Reset {
+            Owned::Reset(q, free, search) => HostMessage::Reset(Reset {
                 q: q.iter().copied().collect(),
                 free: *free,
+                start: if *search { Start::Search } else { Start::Given },
             }),
         }
     }
@@ -62,8 +63,12 @@ fn owned() -> impl Strategy<Value = Owned> {
             prop::collection::vec(any::<u8>(), 0..=MAX_CHUNK)
         )
             .prop_map(|(f, w, h, o, d)| Owned::Chunk(f, w, h, o, d)),
-        (prop::collection::vec(any::<f32>(), 0..=32), any::<u32>())
-            .prop_map(|(q, free)| Owned::Reset(q, free)),
+        (
+            prop::collection::vec(any::<f32>(), 0..=32),
+            any::<u32>(),
+            any::<bool>()
+        )
+            .prop_map(|(q, free, search)| Owned::Reset(q, free, search)),
     ]
 }
 

@@ -59,6 +59,8 @@ fn board_messages() -> std::vec::Vec<BoardMessage> {
             features_expected: u16::MAX,
             iterations: u8::MAX,
             track_ticks: u32::MAX,
+            status: WireStatus::Lost,
+            search_evaluations: u16::MAX,
         }),
         BoardMessage::Features(Features {
             frame,
@@ -132,12 +134,14 @@ fn host_messages(data: &[u8]) -> std::vec::Vec<HostMessage<'_>> {
         HostMessage::Reset(Reset {
             q: full_q(32),
             free: u32::MAX,
+            start: Start::Search,
         }),
         HostMessage::Configure(Configure {
             camera: camera(),
             tracker: TrackerParams::default(),
             features_every: u16::MAX,
             stats_every: u16::MAX,
+            search_evaluations_per_frame: u16::MAX,
         }),
         HostMessage::FrameChunk(FrameChunk {
             frame: u32::MAX,

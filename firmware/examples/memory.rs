@@ -3,10 +3,12 @@
 
 use core::mem::size_of;
 
+use digiteyes_core::acquire::Acquirer;
+use digiteyes_core::auto_tracker::AutoTracker;
 use digiteyes_core::model::Model;
 use digiteyes_core::protocol::{Decoder, MAX_MESSAGE};
 use digiteyes_core::tracker::Tracker;
-use digiteyes_firmware::{Board, Clock, NoLed, Uploads};
+use digiteyes_firmware::{edge_map_bytes, Board, Clock, NoLed, Uploads};
 
 struct NullSerial;
 impl embedded_io::ErrorType for NullSerial {
@@ -43,19 +45,25 @@ impl Clock for NullClock {
 fn main() {
     let board = size_of::<Board<'static, NullSerial, Uploads, NoLed, NullClock>>();
     let tracker = size_of::<Tracker>();
+    let auto = size_of::<AutoTracker>();
+    let acquirer = size_of::<Acquirer>();
     let model = size_of::<Model>();
     let decoder = size_of::<Decoder<MAX_MESSAGE>>();
     let measuring = size_of::<Option<digiteyes_core::remote::MeasureWork>>();
     println!("board (all but frame buffers): {board} B");
-    println!("  tracker (incl. its model and working memory): {tracker} B");
+    println!("  status machine (AutoTracker: tracker, search, leaves): {auto} B");
+    println!("    tracker (incl. its model and working memory): {tracker} B");
+    println!("    search (Acquirer: poses, one projection, the best hypotheses): {acquirer} B");
     println!("  board's own copy of the model: {model} B");
     println!("  receive buffer (decoder): {decoder} B");
     println!("  transmit buffer: {MAX_MESSAGE} B");
     println!("  measuring memory (one board per camera, after Hold): {measuring} B");
     for (name, w, h) in [("QQVGA", 160, 120), ("QVGA", 320, 240), ("VGA", 640, 480)] {
         println!(
-            "frame buffer {name} {w}x{h}: {} B (+ the same again for an overlay)",
-            w * h
+            "frame buffer {name} {w}x{h}: {} B (+ the same again for an overlay); search's \
+             edge map {} B",
+            w * h,
+            edge_map_bytes(w, h)
         );
     }
 }

@@ -2,6 +2,8 @@
 
 use core::convert::Infallible;
 
+use digiteyes_core::acquire::AcquireConfig;
+use digiteyes_core::auto_tracker::{AutoError, AutoTracker};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
@@ -9,11 +11,12 @@ use digiteyes_core::measurement::measure_links;
 use digiteyes_core::model::Model;
 use digiteyes_core::protocol::{
     encode, model_digest, BoardMessage, Capacities, Command, Configure, Decoder, DropReason,
-    Dropped, Features, FrameChunk, Hello, HostMessage, Measure, Measured, Refusal, Reset, State,
-    Stats, MAX_CHUNK, MAX_MESSAGE, PROTOCOL_VERSION,
+    Dropped, Features, FrameChunk, Hello, HostMessage, Measure, Measured, Refusal, Reset, Start,
+    State, Stats, MAX_CHUNK, MAX_MESSAGE, PROTOCOL_VERSION,
 };
 use digiteyes_core::remote::MeasureWork;
-use digiteyes_core::tracker::{FrameReport, Tracker, TrackerConfig, TrackerError};
+use digiteyes_core::status::Status;
+use digiteyes_core::tracker::{FrameReport, TrackerConfig, TrackerError};
 use embedded_hal::delay::DelayNs;
 use embedded_hal::digital::OutputPin;
 use embedded_io::{Read, ReadReady, Write};
@@ -21,6 +24,7 @@ use heapless::{String, Vec};
 
 use crate::clock::Clock;
 use crate::log::{info, log_warn};
+use crate::memory::{search_config, Buffers};
 use crate::overlay;
 use crate::source::FrameSource;
 use crate::upload::{ChunkOutcome, Upload};
@@ -33,6 +37,8 @@ const READ_BLOCK: usize = 64;
 struct Setup {
     camera: Camera,
     config: TrackerConfig,
+    /// The search's parameters (its budget from `Configure`, the rest the board's).
+    acquire: AcquireConfig,
     features_every: u16,
     stats_every: u16,
 }
@@ -52,8 +58,12 @@ pub struct Tracked<'a> {
     pub pixels: &'a [u8],
     /// The state tracked (the `State` message's `q`: quaternion, mm, rad).
     pub q: &'a [f32],
-    /// What the tracker reported for it.
+    /// What the tracker reported for it (`lost` whenever no hand is claimed).
     pub report: &'a FrameReport,
+    /// What the board claims of the frame (the `State` message's `status`).
+    pub status: Status,
+    /// The search's work on the frame, in evaluations (0 while tracking).
+    pub search_evaluations: u16,
 }
 
 /// Where a board hands each tracked frame ([`Board::set_tap`]). It runs inside the board
@@ -67,6 +77,8 @@ struct Node<'m, S, F, L, C> {
     model: Option<Model>,
     frame: &'m mut [u8],
     overlay: Option<&'m mut [u8]>,
+    /// The search's edge map (`Buffers::edge_map`).
+    edge_map: &'m mut [u8],
     overlay_ready: bool,
     tap: Option<Tap<'m>>,
     serial: S,
@@ -75,7 +87,8 @@ struct Node<'m, S, F, L, C> {
     clock: C,
     tx: [u8; MAX_MESSAGE],
     setup: Option<Setup>,
-    tracker: Option<Tracker>,
+    /// The status machine: tracking, or searching for the hand (`Reset`'s `start`).
+    tracker: Option<AutoTracker>,
     /// Set by `Hold`: complete frames are held for `Measure` instead of tracked.
     measuring: Option<MeasureWork>,
     /// The frame held for `Measure`: the last one completed while measuring.
@@ -84,7 +97,7 @@ struct Node<'m, S, F, L, C> {
     stats: Stats,
 }
 
-/// One board: a tracker, its frame buffer and its serial link.
+/// One board: a tracker that finds the hand itself, its buffers and its serial link.
 pub struct Board<'m, S, F, L, C> {
     rx: Decoder<MAX_MESSAGE>,
     node: Node<'m, S, F, L, C>,
@@ -97,13 +110,11 @@ where
     L: OutputPin,
     C: Clock,
 {
-    /// A board named `name` (in `Hello`) tracking the built-in hand model. `frame_buffer`
-    /// holds one frame: its length is the largest frame accepted. `overlay`, when given,
-    /// receives each tracked frame with the model drawn in (it must be as long).
+    /// A board named `name` (in `Hello`) tracking the built-in hand model, in `buffers`
+    /// (the frame, the optional overlay, the search's edge map: [`Buffers`]).
     pub fn new(
         name: &'static str,
-        frame_buffer: &'m mut [u8],
-        overlay: Option<&'m mut [u8]>,
+        buffers: Buffers<'m>,
         serial: S,
         source: F,
         led: L,
@@ -114,8 +125,9 @@ where
             node: Node {
                 name,
                 model: Model::hand().ok(),
-                frame: frame_buffer,
-                overlay,
+                frame: buffers.frame,
+                overlay: buffers.overlay,
+                edge_map: buffers.edge_map,
                 overlay_ready: false,
                 tap: None,
                 serial,
@@ -314,19 +326,38 @@ where
             .tracker
             .to_config()
             .map_err(|_| Refusal::BadParameters)?;
-        if configure.camera.frame_bytes() > self.frame.len() {
+        if configure.search_evaluations_per_frame == 0 {
+            return Err(Refusal::BadParameters);
+        }
+        let acquire = search_config(configure.search_evaluations_per_frame);
+        if configure.camera.frame_bytes() > self.frame.len()
+            || AutoTracker::edge_bytes_needed(&camera, &acquire) > self.edge_map.len()
+        {
             return Err(Refusal::FrameTooLarge);
         }
-        if let Some(tracker) = self.tracker.as_mut() {
-            // Keep estimating from where the board is — state, free states and motion — with
-            // the new camera and parameters.
-            tracker
-                .reconfigure(&[camera], config)
-                .map_err(|_| Refusal::BadCamera)?;
+        let unchanged = self
+            .setup
+            .is_some_and(|s| s.camera == camera && s.config == config && s.acquire == acquire);
+        if !unchanged {
+            if let Some(auto) = self.tracker.take() {
+                // Keep the state, the free states and the status with the new camera and
+                // parameters. `AutoTracker` cannot be reconfigured in place, so the motion
+                // (the velocity of the next prediction) starts over; a `Configure` that
+                // changes neither keeps everything (docs/protocol.md §6).
+                let rebuilt = rebuild(&auto, camera, config, acquire);
+                match rebuilt {
+                    Ok(fresh) => self.tracker = Some(fresh),
+                    Err(refusal) => {
+                        self.tracker = Some(auto);
+                        return Err(refusal);
+                    }
+                }
+            }
         }
         self.setup = Some(Setup {
             camera,
             config,
+            acquire,
             features_every: configure.features_every,
             stats_every: configure.stats_every,
         });
@@ -338,8 +369,8 @@ where
         let built = match &self.setup {
             None => Err(Refusal::NotConfigured),
             Some(setup) => {
-                let (camera, config) = (setup.camera, setup.config);
-                self.build_tracker(&camera, config, &reset.q, reset.free)
+                let setup = *setup;
+                self.build_tracker(&setup, &reset.q, reset.free, reset.start)
             }
         };
         match built {
@@ -357,23 +388,22 @@ where
 
     fn build_tracker(
         &self,
-        camera: &Camera,
-        config: TrackerConfig,
+        setup: &Setup,
         q: &[f32],
         free: u32,
-    ) -> Result<Tracker, Refusal> {
+        start: Start,
+    ) -> Result<AutoTracker, Refusal> {
         let model = self.model.clone().ok_or(Refusal::BadState)?;
         if q.len() != model.n_states() || q.iter().any(|v| !v.is_finite()) {
             return Err(Refusal::BadState);
         }
-        Tracker::new(model, &[*camera], q, FreeMask(free), config).map_err(|e| match e {
-            TrackerError::BadFreeState(_) => Refusal::BadFreeMask,
-            TrackerError::Camera(_) | TrackerError::CameraCount => Refusal::BadCamera,
-            TrackerError::State(_) => Refusal::BadState,
-            // Not returned by `Tracker::new` (they are about frames given to `track`); a
-            // state the tracker cannot start from is the nearest refusal.
-            TrackerError::FrameCount | TrackerError::Frame(_) => Refusal::BadState,
-        })
+        let cameras = [setup.camera];
+        let (free, config, acquire) = (FreeMask(free), setup.config, setup.acquire);
+        match start {
+            Start::Given => AutoTracker::tracking(model, &cameras, q, free, config, acquire),
+            Start::Search => AutoTracker::new(model, &cameras, q, free, config, acquire),
+        }
+        .map_err(refusal_of)
     }
 
     /// Drops and reports a partly uploaded frame: after a new setup its chunks no longer fit.
@@ -451,13 +481,13 @@ where
         let (w, h) = (setup.camera.width as usize, setup.camera.height as usize);
         let timestamp = self.clock.ticks();
         let pixels = self.frame.get(..w * h).unwrap_or_default();
-        let report = match FrameView::packed(pixels, w, h) {
-            Ok(view) => tracker.track(&[view]),
-            Err(e) => Err(TrackerError::Frame(e)),
+        let outcome = match FrameView::packed(pixels, w, h) {
+            Ok(view) => tracker.step(&[view], &mut [&mut *self.edge_map]),
+            Err(e) => Err(AutoError::Tracker(TrackerError::Frame(e))),
         };
         let track_ticks = self.clock.ticks().saturating_sub(timestamp);
-        let report = match report {
-            Ok(report) => report,
+        let outcome = match outcome {
+            Ok(outcome) => outcome,
             Err(_) => {
                 return self.report_drop(Dropped {
                     frame,
@@ -465,12 +495,15 @@ where
                 })
             }
         };
+        let report = outcome.report;
+        let status = outcome.status;
         self.stats.frames += 1;
         self.stats.iterations += u32::from(report.iterations);
         self.stats.lost += u32::from(report.lost);
         let q = Vec::from_slice(tracker.state()).unwrap_or_default();
+        let model = tracker.tracker().model();
         if let Some(out) = self.overlay.as_deref_mut() {
-            overlay::draw(tracker.model(), &setup.camera, tracker.state(), pixels, out);
+            overlay::draw(model, &setup.camera, tracker.state(), pixels, out);
             self.overlay_ready = true;
         }
         if let Some(tap) = self.tap.as_deref_mut() {
@@ -481,13 +514,15 @@ where
                 pixels,
                 q: &q,
                 report: &report,
+                status,
+                search_evaluations: outcome.evaluated,
             });
         }
         let measurements = (setup.features_every != 0
             && self.stats.frames % u32::from(setup.features_every) == 0)
             .then(|| match FrameView::packed(pixels, w, h) {
                 Ok(view) => measure_links(
-                    tracker.model(),
+                    model,
                     &setup.camera,
                     tracker.state(),
                     &view,
@@ -495,17 +530,21 @@ where
                 ),
                 Err(_) => Vec::new(),
             });
-        self.set_led(!report.lost);
+        self.set_led(status.claims_hand());
         self.send(&BoardMessage::State(State {
             frame,
             timestamp,
             q,
             rms_px: report.rms_px,
-            lost: report.lost,
+            // The status machine sets `lost` on every frame that claims no hand; kept tied to
+            // the status here too, so the two can never disagree on the wire.
+            lost: report.lost || !status.claims_hand(),
             features_found: report.features_found,
             features_expected: report.features_expected,
             iterations: report.iterations,
             track_ticks: u32::try_from(track_ticks).unwrap_or(u32::MAX),
+            status: status.into(),
+            search_evaluations: outcome.evaluated,
         }))?;
         if let Some(links) = measurements {
             self.send(&BoardMessage::Features(Features {
@@ -562,6 +601,42 @@ where
         } else {
             self.led.set_low()
         };
+    }
+}
+
+/// `auto` again with a new camera and parameters, from its state, free states and status
+/// (tracking from its state, or searching with its state as the fixed states' values).
+fn rebuild(
+    auto: &AutoTracker,
+    camera: Camera,
+    config: TrackerConfig,
+    acquire: AcquireConfig,
+) -> Result<AutoTracker, Refusal> {
+    let tracker = auto.tracker();
+    let (model, free, cameras) = (tracker.model().clone(), tracker.free(), [camera]);
+    let q = auto.state();
+    match auto.status() {
+        Status::Tracking | Status::Lost => {
+            AutoTracker::tracking(model, &cameras, q, free, config, acquire)
+        }
+        Status::Searching => AutoTracker::new(model, &cameras, q, free, config, acquire),
+    }
+    .map_err(refusal_of)
+}
+
+/// The refusal for a tracker that could not be built.
+fn refusal_of(e: AutoError) -> Refusal {
+    match e {
+        AutoError::Tracker(TrackerError::BadFreeState(_)) => Refusal::BadFreeMask,
+        AutoError::Tracker(TrackerError::Camera(_) | TrackerError::CameraCount) => {
+            Refusal::BadCamera
+        }
+        AutoError::Tracker(TrackerError::State(_)) => Refusal::BadState,
+        // Not returned when a tracker is built (they are about frames given to `step`); a
+        // state the tracker cannot start from is the nearest refusal.
+        AutoError::Tracker(TrackerError::FrameCount | TrackerError::Frame(_))
+        | AutoError::EdgeMap(_)
+        | AutoError::BufferCount => Refusal::BadState,
     }
 }
 

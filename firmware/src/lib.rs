@@ -7,13 +7,15 @@
 //! ```text
 //! serial ─▶ Decoder ─▶ commands (Configure, Reset, Ping)
 //!                   └▶ FrameChunk ─▶ Upload ─┐
-//! FrameSource (camera) ──────────────────────┴▶ frame buffer ─▶ Tracker ─▶ State ─▶ serial
-//!                                                                 └▶ overlay buffer
+//! FrameSource (camera) ──────────────────────┴▶ frame buffer ─▶ AutoTracker ─▶ State ─▶ serial
+//!                                                  (search: edge map) └▶ overlay buffer
 //! ```
 //!
 //! A board crate only wires peripherals: a serial port (embedded-io 0.7 `Read + Write +
 //! ReadReady`), a status LED (embedded-hal 1.0 `OutputPin`), a [`Clock`], a [`FrameSource`]
-//! and caller-owned buffers, then calls [`Board::run`]. The session protocol the loop follows
+//! and caller-owned [`Buffers`], then calls [`Board::run`]. The board finds the hand itself
+//! (`Reset` with `Start::Search`, or after losing it): searching, tracking or lost, its
+//! status is in every `State`. The session protocol the loop follows
 //! is `docs/protocol.md`. Memory is static: the frame and overlay buffers are the caller's,
 //! everything else lives in the [`Board`] value (`docs/firmware.md` gives the sizes).
 #![no_std]
@@ -24,6 +26,7 @@ mod board;
 mod clock;
 mod led;
 mod log;
+mod memory;
 pub mod overlay;
 mod source;
 mod upload;
@@ -31,5 +34,6 @@ mod upload;
 pub use board::{Board, Tap, Tracked};
 pub use clock::Clock;
 pub use led::NoLed;
+pub use memory::{edge_map_bytes, search_config, Buffers, SEARCH_STRIDE_PX};
 pub use source::{FrameSource, SourceError, Uploads};
 pub use upload::{ChunkOutcome, Upload};

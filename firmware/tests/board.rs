@@ -27,6 +27,7 @@ fn configure(stats_every: u16, features_every: u16) -> HostMessage<'static> {
         tracker: TrackerParams::default(),
         features_every,
         stats_every,
+        search_evaluations_per_frame: default_search_evaluations(),
     })
 }
 
@@ -34,6 +35,7 @@ fn reset(q: &[f32]) -> HostMessage<'static> {
     HostMessage::Reset(Reset {
         q: q.iter().copied().collect(),
         free: free_mask(),
+        start: Start::Given,
     })
 }
 
@@ -121,6 +123,11 @@ fn uploaded_frames_give_the_in_process_trackers_states() {
             )
         );
         assert!(state.track_ticks > 0);
+        assert_eq!(
+            (state.status, state.search_evaluations),
+            (WireStatus::Tracking, 0),
+            "a board reset from a given state tracks"
+        );
         assert!(
             report.features_found > 0,
             "the synthetic frame shows the hand"
@@ -334,6 +341,7 @@ fn bad_commands_are_refused_and_change_nothing() {
         tracker: params,
         features_every: 0,
         stats_every: 0,
+        search_evaluations_per_frame: default_search_evaluations(),
     }));
     params.iterations = 0;
     pipe.send(&HostMessage::Configure(Configure {
@@ -341,6 +349,7 @@ fn bad_commands_are_refused_and_change_nothing() {
         tracker: params,
         features_every: 0,
         stats_every: 0,
+        search_evaluations_per_frame: default_search_evaluations(),
     }));
     let mut big = good_cam;
     big.width *= 2;
@@ -349,11 +358,13 @@ fn bad_commands_are_refused_and_change_nothing() {
         tracker: TrackerParams::default(),
         features_every: 0,
         stats_every: 0,
+        search_evaluations_per_frame: default_search_evaluations(),
     }));
     pipe.send(&configure(0, 0));
     pipe.send(&HostMessage::Reset(Reset {
         q: q0[..7].iter().copied().collect(),
         free: free_mask(),
+        start: Start::Given,
     }));
     let mut nan = q0.clone();
     nan[9] = f32::NAN;
@@ -361,6 +372,7 @@ fn bad_commands_are_refused_and_change_nothing() {
     pipe.send(&HostMessage::Reset(Reset {
         q: q0.iter().copied().collect(),
         free: 1 << 30,
+        start: Start::Given,
     }));
     board.poll().unwrap();
     let got = board.serial_mut().received();
@@ -426,8 +438,7 @@ fn a_camera_source_is_tracked_without_uploads() {
     let mut buffer = vec![0u8; FRAME_BYTES];
     let mut board = Board::new(
         "cam",
-        &mut buffer,
-        None,
+        buffers(&mut buffer, None),
         Pipe::default(),
         source,
         NoLed,
@@ -509,8 +520,7 @@ fn the_overlay_draws_the_model_over_the_dimmed_frame() {
     let mut overlay = vec![0u8; FRAME_BYTES];
     let mut board = Board::new(
         "t",
-        &mut buffer,
-        Some(&mut overlay),
+        buffers(&mut buffer, Some(&mut overlay)),
         Pipe::default(),
         Uploads,
         NoLed,

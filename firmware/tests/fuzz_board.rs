@@ -23,7 +23,7 @@ proptest! {
         bytes in prop::collection::vec(any::<u8>(), 0..8192),
     ) {
         let mut buffer = vec![0u8; FRAME_BYTES];
-        let mut board = Board::new("f", &mut buffer, None, Pipe::default(), Uploads, NoLed, StepClock(0));
+        let mut board = Board::new("f", buffers(&mut buffer, None), Pipe::default(), Uploads, NoLed, StepClock(0));
         board.serial_mut().to_board.extend(bytes);
         board.poll().unwrap();
         let got = board.serial_mut().received();
@@ -53,8 +53,9 @@ proptest! {
             tracker: TrackerParams { iterations: 2, ..TrackerParams::default() },
             features_every: 1,
             stats_every: 1,
+            search_evaluations_per_frame: default_search_evaluations(),
         }));
-        host.send(&HostMessage::Reset(Reset { q: q0.iter().copied().collect(), free: 0b1111_0000 }));
+        host.send(&HostMessage::Reset(Reset { q: q0.iter().copied().collect(), free: 0b1111_0000, start: Start::Given }));
         for n in 0..3 {
             host.send_frame(n, WIDTH as u16, HEIGHT as u16, &pixels);
         }
@@ -65,7 +66,7 @@ proptest! {
             }
         }
         let mut buffer = vec![0u8; FRAME_BYTES];
-        let mut board = Board::new("f", &mut buffer, None, host, Uploads, NoLed, StepClock(0));
+        let mut board = Board::new("f", buffers(&mut buffer, None), host, Uploads, NoLed, StepClock(0));
         board.poll().unwrap();
         let got = board.serial_mut().received();
         let mut answered = Vec::new();

@@ -31,6 +31,7 @@ fn configure() -> HostMessage<'static> {
         tracker: TrackerParams::default(),
         features_every: 0,
         stats_every: 0,
+        search_evaluations_per_frame: default_search_evaluations(),
     })
 }
 
@@ -154,6 +155,7 @@ fn a_held_frame_is_measured_as_the_in_process_search_finds_it() {
     board.serial_mut().send(&HostMessage::Reset(Reset {
         q: guess.iter().copied().collect(),
         free: 0b111_0000,
+        start: Start::Given,
     }));
     board
         .serial_mut()

@@ -30,8 +30,7 @@ fn the_tap_sees_every_frame_of_a_pass_with_its_pixels_and_state() {
     };
     let mut board = Board::new(
         "test",
-        &mut buffer,
-        None,
+        buffers(&mut buffer, None),
         Pipe::default(),
         Uploads,
         NoLed,
@@ -44,10 +43,12 @@ fn the_tap_sees_every_frame_of_a_pass_with_its_pixels_and_state() {
         tracker: TrackerParams::default(),
         features_every: 0,
         stats_every: 0,
+        search_evaluations_per_frame: default_search_evaluations(),
     }));
     board.serial_mut().send(&HostMessage::Reset(Reset {
         q: q0.iter().copied().collect(),
         free: [4u8, 5, 8, 9, 10, 19, 24].iter().map(|&s| 1u32 << s).sum(),
+        start: Start::Given,
     }));
     board.poll().unwrap();
     let _ = board.serial_mut().received();

@@ -11,11 +11,12 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
-use digiteyes_core::protocol::{BoardMessage, LinkCounters};
+use digiteyes_core::protocol::{BoardMessage, LinkCounters, Start, WireStatus};
+use digiteyes_core::status::Status;
 
 use crate::forward::one_euro::Smoothing;
 use crate::forward::{Forward, ForwardOptions, Forwarder};
-use crate::link::{set_up_board, DropCause, Link};
+use crate::link::{set_up_board_starting, DropCause, Link};
 
 /// What to listen for and where it goes.
 #[derive(Debug, Clone, Default)]
@@ -36,6 +37,8 @@ pub struct ListenOptions {
     pub setup: Option<PathBuf>,
     /// The camera of a multi-camera setup.
     pub camera_index: Option<usize>,
+    /// With `setup`: how the board starts, from the initial state or searching.
+    pub start: Option<Start>,
 }
 
 /// What a listen session saw.
@@ -45,6 +48,9 @@ pub struct ListenSummary {
     pub messages: usize,
     /// `State`s among them.
     pub states: usize,
+    /// Those states by the board's status: searching, tracking, lost ([`Status::ALL`]'s
+    /// order).
+    pub statuses: [usize; 3],
     /// Datagrams forwarded (to all targets).
     pub forwarded: usize,
     /// The host receiver's counters.
@@ -66,7 +72,8 @@ pub fn listen(link: Link, options: &ListenOptions, out: &mut dyn Write) -> Resul
     };
     let mut link = match &options.setup {
         Some(path) => {
-            let board = set_up_board(link, path, options.camera_index, out)?;
+            let start = options.start.unwrap_or(Start::Given);
+            let board = set_up_board_starting(link, path, options.camera_index, start, out)?;
             let (link, hello) = (board.link, board.hello);
             let initial_state: Vec<f32> = board
                 .sequence
@@ -98,7 +105,13 @@ pub fn listen(link: Link, options: &ListenOptions, out: &mut dyn Write) -> Resul
         };
         let received = Instant::now();
         summary.messages += 1;
-        summary.states += usize::from(matches!(message, BoardMessage::State(_)));
+        if let BoardMessage::State(state) = &message {
+            summary.states += 1;
+            let status = Status::from(state.status);
+            if let Some(i) = Status::ALL.iter().position(|&s| s == status) {
+                summary.statuses[i] += 1;
+            }
+        }
         if options.json {
             writeln!(out, "{}", serde_json::to_string(&message)?)?;
         } else {
@@ -129,9 +142,15 @@ pub fn describe(message: &BoardMessage) -> String {
         ),
         BoardMessage::State(s) => {
             let q: Vec<String> = s.q.iter().map(|v| format!("{v:.4}")).collect();
+            let search = match s.status {
+                WireStatus::Searching => format!(" ({} evaluations)", s.search_evaluations),
+                WireStatus::Tracking | WireStatus::Lost => String::new(),
+            };
             format!(
-                "state {}: rms {:.3} px, {}/{} features, {} iterations, {} ticks{} q=[{}]",
+                "state {} {}{search}: rms {:.3} px, {}/{} features, {} iterations, {} ticks{} \
+                 q=[{}]",
                 s.frame,
+                Status::from(s.status),
                 s.rms_px,
                 s.features_found,
                 s.features_expected,
@@ -221,6 +240,8 @@ mod tests {
                 features_expected: 24,
                 iterations: 5,
                 track_ticks: 1234,
+                status: WireStatus::Tracking,
+                search_evaluations: 0,
             });
             let mut buf = [0u8; MAX_MESSAGE];
             bytes.extend_from_slice(encode(&message, &mut buf).unwrap());

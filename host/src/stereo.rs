@@ -16,6 +16,10 @@
 //! A board that does not answer within the reply timeout is left out — the host carries on
 //! with the cameras that answer and says so — and is asked again on every later frame, so it
 //! is taken back as soon as it answers.
+//!
+//! The host's tracker starts from the sequence's initial state only (it does not search):
+//! the CSV's `status` column, after `track`'s columns, is `tracking` or `lost` (the tracker's
+//! `lost` flag), never `searching`.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -28,11 +32,12 @@ use digiteyes_core::features::{FeatureConfig, LinkFeatures};
 use digiteyes_core::measurer::Measurer;
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_core::protocol::{BoardMessage, HostMessage, LinkEdges, Measure, TrackerParams};
+use digiteyes_core::status::Status;
 use digiteyes_core::tracker::TrackerConfig;
 
 use crate::link::{Link, Session, SessionSetup, DEFAULT_REPLY_TIMEOUT};
 use crate::sequence::{Sequence, StatesWriter};
-use crate::stream::DEFAULT_BAUD;
+use crate::stream::{DEFAULT_BAUD, STATUS_COLUMN};
 
 /// Most boards (cameras) one host drives.
 pub const MAX_BOARDS: usize = digiteyes_core::config::MAX_CAMERAS;
@@ -381,7 +386,7 @@ pub fn stream_stereo(seq: &Path, out_csv: &Path, options: &StereoOptions) -> Res
             answered_this_frame: false,
         });
     }
-    let mut writer = StatesWriter::create(out_csv, sequence.n_states())?;
+    let mut writer = StatesWriter::with_columns(out_csv, sequence.n_states(), &[STATUS_COLUMN])?;
     let bar = crate::progress::bar(sequence.frames, "stream", options.progress);
     let (mut lost, mut rms_sum, mut iterations) = (0, 0.0, 0u64);
     for k in 0..sequence.frames {
@@ -413,8 +418,13 @@ pub fn stream_stereo(seq: &Path, out_csv: &Path, options: &StereoOptions) -> Res
                 board.figures.frames_without += 1;
             }
         }
+        // Given-only: the host's tracker never searches, so a frame is tracking or lost.
+        let status = match report.lost {
+            true => Status::Lost,
+            false => Status::Tracking,
+        };
         writer
-            .write(tracker.state(), &report)
+            .write_with(tracker.state(), &report, &[status.as_str()])
             .with_context(|| format!("frame {k}"))?;
         lost += usize::from(report.lost);
         rms_sum += f64::from(report.rms_px);

@@ -5,15 +5,20 @@
 //! `FrameChunk`s and answered by the board with a `State` or a `Dropped` (see
 //! [`link::Session`](crate::link::Session)). Every frame gets a row, in order: a dropped frame
 //! repeats the last state with `lost` = 1, and the extra last column `dropped` says why
-//! (empty for tracked frames). The summary adds the board's own measure of its work
-//! ([`BoardWork`]: `State::track_ticks` in ticks of its clock, `Hello::clock_hz`).
+//! (empty for tracked frames), and then `status`, what the board claimed of the frame
+//! (`searching`, `tracking` or `lost`; `lost` for a dropped frame; `lost` is 1 on every row
+//! that is not `tracking`). The board starts tracking from the sequence's initial state, or
+//! searching for the hand ([`StreamOptions::start`], `--init auto`). The summary adds the
+//! statuses and the board's own measure of its work ([`BoardWork`]: `State::track_ticks` in
+//! ticks of its clock, `Hello::clock_hz`).
 
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{anyhow, ensure, Context, Result};
-use digiteyes_core::protocol::{State, TrackerParams};
+use digiteyes_core::protocol::{default_search_evaluations, Start, State, TrackerParams};
+use digiteyes_core::status::Status;
 use digiteyes_core::tracker::FrameReport;
 use digiteyes_platform_linux::camera::V4l2Camera;
 
@@ -24,6 +29,9 @@ use crate::sequence::{Sequence, StatesWriter};
 
 /// The column `stream` adds after `track`'s: why a frame was not tracked.
 pub const DROPPED_COLUMN: &str = "dropped";
+
+/// The column after it: the board's status for the frame (`Status::as_str`'s words).
+pub const STATUS_COLUMN: &str = "status";
 
 /// The default line speed (bits/s).
 pub const DEFAULT_BAUD: u32 = 115_200;
@@ -42,6 +50,11 @@ pub struct StreamOptions {
     pub camera_index: Option<usize>,
     /// The tracker parameters sent in `Configure`.
     pub tracker: TrackerParams,
+    /// How the board starts (`Reset`): from the sequence's initial state, or searching for
+    /// the free states (`--init auto`).
+    pub start: Start,
+    /// The board's search budget per frame, in evaluations (`Configure`).
+    pub search_evaluations_per_frame: u16,
     /// Show a progress bar (when stderr is a terminal).
     pub progress: bool,
 }
@@ -55,8 +68,16 @@ impl StreamOptions {
             reply_timeout: DEFAULT_REPLY_TIMEOUT,
             camera_index: None,
             tracker: TrackerParams::default(),
+            start: Start::Given,
+            search_evaluations_per_frame: default_search_evaluations(),
             progress: false,
         }
+    }
+
+    /// Starting the board this way.
+    pub fn start(mut self, start: Start) -> Self {
+        self.start = start;
+        self
     }
 
     /// With this reply timeout.
@@ -119,6 +140,21 @@ impl StreamSummary {
             );
         }
         Ok(())
+    }
+
+    /// Frames the board answered with each status, in [`Status::ALL`]'s order (searching,
+    /// tracking, lost).
+    pub fn statuses(&self) -> [usize; 3] {
+        let mut counts = [0; 3];
+        for outcome in &self.outcomes {
+            if let FrameOutcome::Tracked(state) = outcome {
+                let status = Status::from(state.status);
+                if let Some(i) = Status::ALL.iter().position(|&s| s == status) {
+                    counts[i] += 1;
+                }
+            }
+        }
+        counts
     }
 
     /// The dropped frames and why, in order.
@@ -209,6 +245,11 @@ impl fmt::Display for StreamSummary {
             self.link.dropped_total(),
             self.mean_rms_px
         )?;
+        let [searching, tracking, lost] = self.statuses();
+        writeln!(
+            f,
+            "board status: {tracking} tracking, {lost} lost, {searching} searching"
+        )?;
         let dropped = self.dropped();
         if !dropped.is_empty() {
             let list: Vec<String> = dropped
@@ -292,6 +333,8 @@ fn pick_camera(sequence: &Sequence, index: Option<usize>) -> Result<usize> {
 fn connect(sequence: &Sequence, options: &StreamOptions) -> Result<Session> {
     let mut setup = SessionSetup::from_sequence(sequence, options.camera_index)?;
     setup.tracker = options.tracker;
+    setup.start = options.start;
+    setup.search_evaluations_per_frame = options.search_evaluations_per_frame;
     setup.reply_timeout = options.reply_timeout;
     let link = Link::open(&options.port, options.baud)?;
     Session::start(link, setup)
@@ -307,7 +350,11 @@ fn run(
     out_csv: &Path,
     options: &StreamOptions,
 ) -> Result<StreamSummary> {
-    let mut writer = StatesWriter::with_columns(out_csv, sequence.n_states(), &[DROPPED_COLUMN])?;
+    let mut writer = StatesWriter::with_columns(
+        out_csv,
+        sequence.n_states(),
+        &[DROPPED_COLUMN, STATUS_COLUMN],
+    )?;
     let bar = crate::progress::bar(expected, "stream", options.progress);
     let mut last: Vec<f32> = sequence.initial_state.iter().map(|&v| v as f32).collect();
     let mut outcomes = Vec::with_capacity(expected);
@@ -328,7 +375,8 @@ fn run(
                 );
                 last.copy_from_slice(&state.q);
                 rms_sum += f64::from(state.rms_px);
-                writer.write_with(&last, &report_of(state), &[""])?;
+                let status = Status::from(state.status).as_str();
+                writer.write_with(&last, &report_of(state), &["", status])?;
             }
             FrameOutcome::Dropped(cause) => {
                 let report = FrameReport {
@@ -336,7 +384,8 @@ fn run(
                     lost: true,
                     ..FrameReport::default()
                 };
-                writer.write_with(&last, &report, &[&cause.to_string()])?;
+                let lost = Status::Lost.as_str();
+                writer.write_with(&last, &report, &[&cause.to_string(), lost])?;
             }
         }
         outcomes.push(outcome);
@@ -356,14 +405,14 @@ fn run(
     })
 }
 
-/// The tracker's report as the board sent it.
+/// The tracker's report as the board sent it (`lost` whenever the board claims no hand).
 pub fn report_of(state: &State) -> FrameReport {
     FrameReport {
         rms_px: state.rms_px,
         features_found: state.features_found,
         features_expected: state.features_expected,
         iterations: state.iterations,
-        lost: state.lost,
+        lost: state.lost || !Status::from(state.status).claims_hand(),
         ..FrameReport::default()
     }
 }
@@ -371,9 +420,13 @@ pub fn report_of(state: &State) -> FrameReport {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use digiteyes_core::protocol::DropReason;
+    use digiteyes_core::protocol::{DropReason, WireStatus};
 
     fn tracked(track_ticks: u32, iterations: u8) -> FrameOutcome {
+        with_status(track_ticks, iterations, WireStatus::Tracking)
+    }
+
+    fn with_status(track_ticks: u32, iterations: u8, status: WireStatus) -> FrameOutcome {
         FrameOutcome::Tracked(State {
             frame: 0,
             timestamp: 0,
@@ -384,6 +437,8 @@ mod tests {
             features_expected: 10,
             iterations,
             track_ticks,
+            status,
+            search_evaluations: 0,
         })
     }
 
@@ -433,5 +488,29 @@ mod tests {
         assert!(e.contains("tracked none of the 2 frame(s)"), "{e}");
         summary.link.tracked = 1;
         assert!(summary.ensure_some_tracked().is_ok());
+    }
+
+    #[test]
+    fn the_summary_counts_the_boards_statuses() {
+        let summary = StreamSummary {
+            frames: 5,
+            outcomes: vec![
+                with_status(10, 0, WireStatus::Searching),
+                with_status(10, 0, WireStatus::Searching),
+                tracked(10, 8),
+                with_status(10, 8, WireStatus::Lost),
+                FrameOutcome::Dropped(DropCause::NoReply),
+            ],
+            mean_rms_px: 0.5,
+            out: PathBuf::from("states.csv"),
+            link: LinkReport::default(),
+            board_clock_hz: 1,
+        };
+        assert_eq!(summary.statuses(), [2, 1, 1]);
+        let text = summary.to_string();
+        assert!(
+            text.contains("board status: 1 tracking, 1 lost, 2 searching"),
+            "{text}"
+        );
     }
 }

@@ -296,7 +296,11 @@ fn sim_then_stream_then_eval_from_the_command_line() {
     );
     let states = std::fs::read_to_string(dir.path().join("s.csv")).unwrap();
     assert!(
-        states.lines().next().unwrap().ends_with(",lost,dropped"),
+        states
+            .lines()
+            .next()
+            .unwrap()
+            .ends_with(",lost,dropped,status"),
         "{states}"
     );
     assert_eq!(states.lines().count(), 4);
@@ -340,6 +344,8 @@ fn listen_prints_and_forwards_json_lines_over_udp() {
             features_expected: 24,
             iterations: 5,
             track_ticks: 1234,
+            status: digiteyes_core::protocol::WireStatus::Tracking,
+            search_evaluations: 0,
         })
     };
     let dropped = BoardMessage::Dropped(Dropped {

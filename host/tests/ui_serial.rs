@@ -23,6 +23,8 @@ fn state(frame: u32, q4: f32) -> BoardMessage {
         features_expected: 24,
         iterations: 5,
         track_ticks: 1234,
+        status: digiteyes_core::protocol::WireStatus::Tracking,
+        search_evaluations: 0,
     })
 }
 

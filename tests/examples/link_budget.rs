@@ -6,8 +6,8 @@
 
 use digiteyes_core::model::Model;
 use digiteyes_core::protocol::{
-    encode, BoardMessage, DropReason, Dropped, FrameChunk, HostMessage, State, Stats, MAX_CHUNK,
-    MAX_MESSAGE,
+    encode, BoardMessage, DropReason, Dropped, FrameChunk, HostMessage, State, Stats, WireStatus,
+    MAX_CHUNK, MAX_MESSAGE,
 };
 
 const BAUDS: [u32; 2] = [115_200, 921_600];
@@ -37,6 +37,8 @@ fn state(q: &[f32]) -> BoardMessage {
         features_expected: 68,
         iterations: 8,
         track_ticks: 5_000,
+        status: WireStatus::Tracking,
+        search_evaluations: 0,
     })
 }
 
@@ -82,6 +84,8 @@ fn main() {
         features_expected: u16::MAX,
         iterations: u8::MAX,
         track_ticks: u32::MAX,
+        status: WireStatus::Searching,
+        search_evaluations: u16::MAX,
     });
     let dropped = BoardMessage::Dropped(Dropped {
         frame: 1000,

@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use digiteyes_core::frame::FrameView;
-use digiteyes_core::protocol::DropReason;
+use digiteyes_core::protocol::{DropReason, Start, WireStatus};
 use digiteyes_host::link::{DropCause, FrameOutcome, Link, Session, SessionSetup};
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::sim::{Corruption, SimBoard, SimOptions, SimReport, Window};
@@ -190,6 +190,47 @@ fn a_board_power_cycle_mid_sequence_is_followed() {
     }
     // The rebooted board counted from its boot: the frames after the restart.
     assert_eq!(summary.link.board.unwrap().frames, 4);
+}
+
+/// A board that was searching when it rebooted is set up to search again (not to track the
+/// state it sent while searching, which is no estimate); one that was tracking resumes from its
+/// last state.
+#[test]
+fn a_searching_board_that_reboots_searches_again() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = mouse(dir.path(), 4);
+    let sequence = Sequence::open(&seq).unwrap();
+    for (start, after_reboot) in [
+        (Start::Search, WireStatus::Searching),
+        (Start::Given, WireStatus::Tracking),
+    ] {
+        let board = SimBoard::start(SimOptions::default().restart_after(1)).unwrap();
+        let link = Link::open(&board.path().display().to_string(), 115_200).unwrap();
+        let mut setup = SessionSetup::from_sequence(&sequence, None).unwrap();
+        setup.start = start;
+        setup.reply_timeout = Duration::from_secs(5);
+        let mut session = Session::start(link, setup).unwrap();
+        let frame = |k| sequence.read_frame(0, k).unwrap().into_raw();
+        let status = |outcome: FrameOutcome| match outcome {
+            FrameOutcome::Tracked(state) => state.status,
+            other => panic!("{start:?}: {other:?}"),
+        };
+        // The first frame of a search can only search; a given start tracks.
+        let first = status(session.track(0, &frame(0), 320, 240).unwrap());
+        let expected_first = match start {
+            Start::Search => WireStatus::Searching,
+            Start::Given => WireStatus::Tracking,
+        };
+        assert_eq!(first, expected_first);
+        assert_eq!(
+            session.track(1, &frame(1), 320, 240).unwrap(),
+            FrameOutcome::Dropped(DropCause::BoardRestarted),
+            "{start:?}: the board rebooted under frame 1"
+        );
+        let next = status(session.track(2, &frame(2), 320, 240).unwrap());
+        assert_eq!(next, after_reboot, "{start:?}: the frame after the reboot");
+        board.stop().unwrap();
+    }
 }
 
 #[test]

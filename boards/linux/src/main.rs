@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::Parser;
 use digiteyes_board_linux::{Source, StatusLed, BOARD_NAME};
-use digiteyes_firmware::{Board, NoLed, Uploads};
+use digiteyes_firmware::{edge_map_bytes, Board, Buffers, NoLed, Uploads};
 use digiteyes_platform_linux::camera::V4l2Camera;
 use digiteyes_platform_linux::{parse_frame_size, MonotonicClock, TtySerial};
 use linux_embedded_hal::Delay;
@@ -82,10 +82,14 @@ fn run(args: Args) -> Result<()> {
             None => "host uploads".to_string(),
         }
     );
+    let mut edge_map = vec![0u8; edge_map_bytes(width as usize, height as usize)];
     let mut board = Board::new(
         BOARD_NAME,
-        &mut frame_buffer,
-        None,
+        Buffers {
+            frame: &mut frame_buffer,
+            overlay: None,
+            edge_map: &mut edge_map,
+        },
         serial,
         source,
         led,

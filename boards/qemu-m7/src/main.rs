@@ -7,8 +7,9 @@
 //! painted at reset) after boot and, between frames, whenever a stretch of frames went deeper
 //! than any before.
 //!
-//! Memory is static: the frame buffer and the overlay buffer (VGA, 307,200 bytes each) and
-//! the `Board` (tracker, model, link buffers) live in `static` cells; nothing is allocated.
+//! Memory is static: the frame buffer and the overlay buffer (VGA, 307,200 bytes each), the
+//! search's edge map (115,200 bytes) and the `Board` (tracker and search, model, link
+//! buffers) live in `static` cells; nothing is allocated.
 #![no_std]
 #![no_main]
 #![deny(unsafe_code)]
@@ -23,7 +24,7 @@ use digiteyes_board_qemu_m7::{
     uart::{self, Uart, UART0_BASE},
     Peripherals,
 };
-use digiteyes_firmware::{Board, Uploads};
+use digiteyes_firmware::{edge_map_bytes, Board, Buffers, Uploads};
 use embedded_hal::delay::DelayNs;
 use static_cell::{ConstStaticCell, StaticCell};
 
@@ -31,7 +32,11 @@ use static_cell::{ConstStaticCell, StaticCell};
 const BOARD_NAME: &str = "qemu-m7";
 
 /// The largest frame the board takes: VGA, 8-bit grey.
-const FRAME_BYTES: usize = 640 * 480;
+const FRAME_WIDTH_PX: usize = 640;
+const FRAME_HEIGHT_PX: usize = 480;
+const FRAME_BYTES: usize = FRAME_WIDTH_PX * FRAME_HEIGHT_PX;
+/// The search's edge map of the largest frame (115,200 bytes for VGA).
+const EDGE_MAP_BYTES: usize = edge_map_bytes(FRAME_WIDTH_PX, FRAME_HEIGHT_PX);
 
 /// How long a pass of the loop that found nothing to do waits before the next (µs). Short:
 /// QEMU hands UART0 the next received byte only after the firmware has read the previous one,
@@ -45,6 +50,8 @@ type TrackerBoard = Board<'static, Uart, Uploads, Led, Clock>;
 static FRAME: ConstStaticCell<[u8; FRAME_BYTES]> = ConstStaticCell::new([0; FRAME_BYTES]);
 /// The last tracked frame with the model drawn in (the IC40's video overlay).
 static OVERLAY: ConstStaticCell<[u8; FRAME_BYTES]> = ConstStaticCell::new([0; FRAME_BYTES]);
+/// The search's edge map (the board searches for the hand when asked or after losing it).
+static EDGE_MAP: ConstStaticCell<[u8; EDGE_MAP_BYTES]> = ConstStaticCell::new([0; EDGE_MAP_BYTES]);
 /// The board: tracker, model, link buffers, counters.
 static BOARD: StaticCell<TrackerBoard> = StaticCell::new();
 
@@ -95,8 +102,11 @@ fn build(serial: Uart, status_led: Led, clock: Clock) -> &'static mut TrackerBoa
     BOARD.init_with(|| {
         Board::new(
             BOARD_NAME,
-            FRAME.take(),
-            Some(OVERLAY.take()),
+            Buffers {
+                frame: FRAME.take(),
+                overlay: Some(OVERLAY.take()),
+                edge_map: EDGE_MAP.take(),
+            },
             serial,
             Uploads,
             status_led,

@@ -8,8 +8,10 @@ use heapless::{String, Vec};
 use serde::{Deserialize, Serialize};
 
 use super::params::{CameraParams, TrackerParams};
+use crate::acquire::AcquireConfig;
 use crate::config::{MAX_LINKS, MAX_STATES};
 use crate::features::MAX_LINK_EDGES;
+use crate::status::Status;
 
 /// Longest board name in [`Hello`] (bytes of UTF-8).
 pub const MAX_BOARD_NAME: usize = 24;
@@ -46,7 +48,8 @@ pub enum BoardMessage {
 /// Host → board.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum HostMessage<'a> {
-    /// Start tracking afresh from a state, estimating the `free` states.
+    /// Start afresh, estimating the `free` states: tracking from a state, or searching for
+    /// the hand ([`Start`], version 4).
     Reset(Reset),
     /// The camera and the tracker parameters. Needed once before frames are tracked.
     Configure(Configure),
@@ -152,6 +155,46 @@ pub struct State {
     pub iterations: u8,
     /// Board clock ticks spent tracking this frame.
     pub track_ticks: u32,
+    /// What the board claims of this frame (version 4): only [`WireStatus::Tracking`] claims
+    /// a hand; `lost` is true whenever the status is not `Tracking`.
+    pub status: WireStatus,
+    /// The search's work on this frame, in evaluations (one hypothesis scored counts 1; see
+    /// `acquire::AcquireConfig::evaluations_per_frame`): 0 on a tracking frame (version 4).
+    pub search_evaluations: u16,
+}
+
+/// The tracker's status after a frame, as it crosses the link (version 4): a wire type of
+/// its own, converted to and from [`Status`], so the core's type can change without changing
+/// the protocol.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum WireStatus {
+    /// No hand claimed: the board searches for it.
+    Searching,
+    /// The hand is tracked.
+    Tracking,
+    /// The hand was tracked and this frame lost it (the last good state is held).
+    Lost,
+}
+
+impl From<Status> for WireStatus {
+    fn from(status: Status) -> Self {
+        match status {
+            Status::Searching => WireStatus::Searching,
+            Status::Tracking => WireStatus::Tracking,
+            Status::Lost => WireStatus::Lost,
+        }
+    }
+}
+
+impl From<WireStatus> for Status {
+    fn from(status: WireStatus) -> Self {
+        match status {
+            WireStatus::Searching => Status::Searching,
+            WireStatus::Tracking => Status::Tracking,
+            WireStatus::Lost => Status::Lost,
+        }
+    }
 }
 
 /// A measured axis line in the image: a point on it and its unit direction (px).
@@ -301,7 +344,7 @@ pub struct Dropped {
     pub reason: DropReason,
 }
 
-/// Start tracking afresh.
+/// Start afresh: tracking from a given state, or searching for the hand.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Reset {
     /// Every model state (quaternion, mm, rad).
@@ -309,6 +352,19 @@ pub struct Reset {
     /// Bit `i` set: state `i` is estimated; the others stay as given. Naming any quaternion
     /// state frees all four.
     pub free: u32,
+    /// Where to start (version 4): from `q`, or by searching for the free states.
+    pub start: Start,
+}
+
+/// How a [`Reset`] starts the board (version 4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Start {
+    /// Track from the given state (the status starts `Tracking`).
+    Given,
+    /// Search for the hand (the status starts `Searching`): the free states' given values
+    /// are ignored, the fixed states keep theirs.
+    Search,
 }
 
 /// The camera and how to track.
@@ -322,6 +378,16 @@ pub struct Configure {
     pub features_every: u16,
     /// Send [`BoardMessage::Stats`] every this many frames (0: only when pinged).
     pub stats_every: u16,
+    /// The search's budget per frame, in evaluations, at least 1 (version 4; `acquire`'s
+    /// `AcquireConfig::evaluations_per_frame`; default [`default_search_evaluations`]): a
+    /// searching board answers every frame after at most this much search work (and the one
+    /// hypothesis under way).
+    pub search_evaluations_per_frame: u16,
+}
+
+/// The search budget per frame a host sends by default: the search's own default.
+pub fn default_search_evaluations() -> u16 {
+    AcquireConfig::default().evaluations_per_frame
 }
 
 /// A piece of an 8-bit grey frame, rows top to bottom, packed (stride = width).

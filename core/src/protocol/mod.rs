@@ -27,7 +27,10 @@ pub use params::{BadParameter, CameraParams, TrackerParams, WireResidual, WireRo
 /// canonical form of `docs/protocol.md` §7 (version 1 digested `write_dh`'s text).
 /// Version 3: `Hold` and `Measure` (host), `LinkEdges` and `Measured` (board), `Command::Hold`:
 /// one board per camera, measuring for a host that solves (docs/protocol.md §9).
-pub const PROTOCOL_VERSION: u8 = 3;
+/// Version 4: the board finds the hand itself: `State` gained `status` and
+/// `search_evaluations`, `Reset` gained `start` (from the given state, or search), `Configure`
+/// gained `search_evaluations_per_frame` (docs/protocol.md §10).
+pub const PROTOCOL_VERSION: u8 = 4;
 
 /// Largest `FrameChunk` payload (bytes).
 pub const MAX_CHUNK: usize = 1024;

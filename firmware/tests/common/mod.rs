@@ -13,7 +13,9 @@ use digiteyes_core::projection::ProjectedModel;
 use digiteyes_core::protocol::{
     encode, BoardMessage, Decoder, FrameChunk, HostMessage, MAX_CHUNK, MAX_MESSAGE,
 };
-use digiteyes_firmware::{Board, Clock, FrameSource, NoLed, SourceError, Uploads};
+use digiteyes_firmware::{
+    edge_map_bytes, Board, Buffers, Clock, FrameSource, NoLed, SourceError, Uploads,
+};
 
 pub const WIDTH: u32 = 160;
 pub const HEIGHT: u32 = 120;
@@ -190,12 +192,22 @@ pub fn render(model: &Model, camera: &Camera, q: &[f32]) -> Vec<u8> {
 /// A board on the in-memory port, taking uploaded frames, with a step clock.
 pub type TestBoard<'m> = Board<'m, Pipe, Uploads, NoLed, StepClock>;
 
+/// A board's memory: `frame` and `overlay`, and an edge map for [`WIDTH`] × [`HEIGHT`] frames
+/// (leaked: a test's few kilobytes, as long-lived as a board's `static`).
+pub fn buffers<'m>(frame: &'m mut [u8], overlay: Option<&'m mut [u8]>) -> Buffers<'m> {
+    let edge_map = vec![0u8; edge_map_bytes(WIDTH as usize, HEIGHT as usize)];
+    Buffers {
+        frame,
+        overlay,
+        edge_map: Box::leak(edge_map.into_boxed_slice()),
+    }
+}
+
 /// A [`TestBoard`] named `name` with frame buffer `buffer` (not yet started).
 pub fn test_board<'m>(name: &'static str, buffer: &'m mut [u8]) -> TestBoard<'m> {
     Board::new(
         name,
-        buffer,
-        None,
+        buffers(buffer, None),
         Pipe::default(),
         Uploads,
         NoLed,

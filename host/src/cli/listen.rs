@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args;
 
+use super::stream::InitArg;
 use crate::cli_values;
 use crate::forward::one_euro::{self, Smoothing};
 use crate::forward::parse_forward;
@@ -15,7 +16,9 @@ use crate::stream::DEFAULT_BAUD;
 /// Print what a board sends (states, drops, counters) and forward it over UDP.
 ///
 /// Decodes every message on the serial port and prints one line each: text by default,
-/// JSON with --json (e.g. {"State":{"frame":12,"timestamp":…,"q":[…],"rms_px":…,…}}).
+/// JSON with --json (e.g. {"State":{"frame":12,"timestamp":…,"q":[…],"rms_px":…,…,
+/// "status":"Tracking",…}}). Each state's line names the board's status (searching,
+/// tracking or lost); the summary on stderr counts them.
 /// With --forward, messages also go to the machines that show the hand, as JSON lines
 /// (udp://) or Open Sound Control (osc://: /digiteyes/state, /digiteyes/q/N,
 /// /digiteyes/mouse, /digiteyes/dropped, /digiteyes/stats; see docs/forwarding.md).
@@ -63,6 +66,10 @@ pub struct ListenArgs {
     /// folder: camera calibration, initial state, free states.
     #[arg(long, value_name = "PATH")]
     pub setup: Option<PathBuf>,
+    /// With --setup: how the board starts: `given` tracks from initial_state; `auto`
+    /// searches for the hand (the free states' initial values ignored, the fixed ones kept).
+    #[arg(long, value_enum, requires = "setup", default_value_t = InitArg::Given)]
+    pub init: InitArg,
     /// With --setup: the camera of a multi-camera description (0-based).
     #[arg(long, value_name = "N")]
     pub camera_index: Option<usize>,
@@ -112,14 +119,17 @@ pub fn run(args: ListenArgs) -> Result<()> {
         },
         setup: args.setup,
         camera_index: args.camera_index,
+        start: Some(args.init.into()),
         states: args.states,
         duration: args.seconds.map(cli_values::duration),
     };
     let link = Link::open(&port.port, port.baud)?;
     eprintln!("listening on {}", port.port);
     let summary = listen(link, &options, &mut std::io::stdout().lock())?;
+    let [searching, tracking, lost] = summary.statuses;
     eprintln!(
-        "{} messages ({} states), {} forwarded; {} CRC errors, {} framing errors",
+        "{} messages ({} states: {tracking} tracking, {lost} lost, {searching} searching), {} \
+         forwarded; {} CRC errors, {} framing errors",
         summary.messages,
         summary.states,
         summary.forwarded,

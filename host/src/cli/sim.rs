@@ -113,8 +113,7 @@ pub fn run(args: SimArgs) -> Result<()> {
     if boards > 1 && (args.overlay.is_some() || args.ui.is_some()) {
         bail!("--overlay and --ui watch one board: leave them out with --boards {boards}");
     }
-    let mut options = SimOptions::default()
-        .frame_buffer_bytes(args.max_frame.0 as usize * args.max_frame.1 as usize);
+    let mut options = SimOptions::default().max_frame(args.max_frame.0, args.max_frame.1);
     if args.corrupt > 0.0 || args.corrupt_frames.is_some() {
         options = options.corruption(corruption(
             args.corrupt,

@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
-use clap::Args;
-use digiteyes_core::protocol::TrackerParams;
+use clap::{Args, ValueEnum};
+use digiteyes_core::protocol::{Start, TrackerParams};
 
 use super::tracker_config;
 use crate::cli_values;
@@ -21,7 +21,11 @@ use crate::stream::{stream_camera, stream_sequence, StreamOptions, DEFAULT_BAUD}
 /// order) plus a last column `dropped`: empty for tracked frames; for a frame the board
 /// did not track, the reason (incomplete, wrong size WxH, too large, not ready,
 /// superseded, tracker error, no reply (timeout), board restarted) — its row repeats the
-/// last state with lost = 1. Prints a summary and the link's figures (states/s, bytes,
+/// last state with lost = 1 — and then a column `status`: what the board claimed of the
+/// frame, searching, tracking or lost (lost for a dropped frame; lost = 1 on every row
+/// that is not tracking). With --init auto the board searches for the hand instead of
+/// starting from initial_state; either way it searches again after losing the hand.
+/// Prints a summary (with the statuses) and the link's figures (states/s, bytes,
 /// CRC/framing errors on both ends, the board's drops by reason). A board tracks one
 /// camera: a stereo sequence needs --camera-index, or one board per camera.
 ///
@@ -64,6 +68,16 @@ pub struct StreamArgs {
     /// ran one per frame).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(1..=50))]
     pub iterations: Option<u8>,
+    /// How the board starts: `given` tracks from sequence.json's initial_state; `auto`
+    /// searches for the hand (the free states' initial values are ignored, the fixed ones
+    /// kept). One board per camera (the host's own tracker) supports `given` only.
+    #[arg(long, value_enum, default_value_t = InitArg::Given)]
+    pub init: InitArg,
+    /// The board's search budget: evaluations per frame at most while it searches, 1 to
+    /// 65535 (default: the search's, 1000). Lower keeps a searching frame's time nearer a
+    /// tracking frame's; the search then takes more frames.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub search_evaluations: Option<u16>,
     /// Output CSV path (default: states.csv in the current folder).
     #[arg(long, short, default_value = "states.csv", hide_default_value = true)]
     pub out: PathBuf,
@@ -92,6 +106,24 @@ pub struct StreamPorts {
     pub reply_timeout: f64,
 }
 
+/// How a board starts (`--init`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum InitArg {
+    /// From the sequence's initial state.
+    Given,
+    /// Searching for the hand.
+    Auto,
+}
+
+impl From<InitArg> for Start {
+    fn from(init: InitArg) -> Self {
+        match init {
+            InitArg::Given => Start::Given,
+            InitArg::Auto => Start::Search,
+        }
+    }
+}
+
 /// Streams to the board(s), writes the CSV and prints the summary; fails when no frame was
 /// tracked.
 pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
@@ -100,10 +132,17 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
     if port.port.len() > 1 {
         let Some(seq) = args.seq else {
             bail!(
-                "one board per camera (--port given {} times) needs --seq DIR: a                          sequence with that many cameras",
+                "one board per camera (--port given {} times) needs --seq DIR: a \
+                 sequence with that many cameras",
                 port.port.len()
             );
         };
+        if args.init == InitArg::Auto {
+            bail!(
+                "--init auto: with one board per camera the host tracks, from the sequence's \
+                 initial_state only (accepted: --init given); a single board searches itself"
+            );
+        }
         if args.camera_index.is_some() {
             bail!("--camera-index picks the one camera of a single board; with one --port per camera leave it out");
         }
@@ -124,8 +163,12 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
         .baud(port.baud)
         .reply_timeout(cli_values::duration(port.reply_timeout))
         .camera_index(args.camera_index)
+        .start(args.init.into())
         .progress(progress && !args.quiet);
     options.tracker = tracker;
+    if let Some(n) = args.search_evaluations {
+        options.search_evaluations_per_frame = n;
+    }
     let summary = match (args.seq, args.camera, args.setup) {
         (Some(seq), None, _) => stream_sequence(&seq, &args.out, &options)?,
         (None, Some(camera), Some(setup)) => {

@@ -170,6 +170,8 @@ mod tests {
             features_expected: 24,
             iterations: 5,
             track_ticks: 1234,
+            status: digiteyes_core::protocol::WireStatus::Lost,
+            search_evaluations: 0,
         }
     }
 

@@ -112,6 +112,8 @@ fn state(frame: u32, timestamp: u64, q: &[f32]) -> State {
         features_expected: 24,
         iterations: 5,
         track_ticks: 1234,
+        status: digiteyes_core::protocol::WireStatus::Tracking,
+        search_evaluations: 0,
     }
 }
 

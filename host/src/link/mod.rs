@@ -18,5 +18,5 @@ mod setup;
 pub use outcome::{DropCause, FrameOutcome};
 pub use port::Link;
 pub use report::LinkReport;
-pub use session::{set_up_board, Session, SetUpBoard};
+pub use session::{set_up_board, set_up_board_starting, Session, SetUpBoard};
 pub use setup::{SessionSetup, DEFAULT_REPLY_TIMEOUT};

@@ -4,10 +4,11 @@
 //! ```text
 //! host                                   board
 //!  Configure ───────────────────────────▶  Ack(Configure)
-//!  Reset(q, free) ──────────────────────▶  Hello, Ack(Reset)      (Hello checked: version, model)
+//!  Reset(q, free, start) ───────────────▶  Hello, Ack(Reset)      (Hello checked: version, model)
 //!  FrameChunk × ⌈w·h / MAX_CHUNK⌉ ───────▶  State | Dropped        (one answer per frame)
 //!  …                                      Hello (unsolicited: it rebooted → Configure, Reset
-//!                                                from the last state, go on)
+//!                                                from the last state, or searching again if
+//!                                                it was searching; go on)
 //!  Ping(t) ─────────────────────────────▶  Stats, Pong(t)
 //! ```
 
@@ -18,8 +19,8 @@ use std::time::Instant;
 use anyhow::{bail, Result};
 use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::protocol::{
-    BoardMessage, Command, Configure, FrameChunk, Hello, HostMessage, Refusal, Reset, MAX_CHUNK,
-    PROTOCOL_VERSION,
+    BoardMessage, Command, Configure, FrameChunk, Hello, HostMessage, Refusal, Reset, Start,
+    WireStatus, MAX_CHUNK, PROTOCOL_VERSION,
 };
 use heapless::Vec as HVec;
 
@@ -43,8 +44,11 @@ pub struct Session {
     link: Link,
     setup: SessionSetup,
     hello: Hello,
-    /// The state to restart from after a reboot: the last tracked one.
+    /// The state to restart from after a reboot: the last one the board sent.
     last_state: Vec<f32>,
+    /// How to restart after a reboot: searching again if the board was searching, else from
+    /// `last_state`.
+    last_start: Start,
     started: Instant,
     report: LinkReport,
     /// Pings sent to probe for lost answers (their tokens count up from 1; the final ping's
@@ -61,6 +65,7 @@ impl Session {
         let mut session = Session {
             link,
             last_state: setup.initial_state.clone(),
+            last_start: setup.start,
             setup,
             hello: placeholder_hello(),
             started: Instant::now(),
@@ -69,7 +74,7 @@ impl Session {
             silent: 0,
         };
         let q = session.last_state.clone();
-        session.hello = session.handshake(&q, None)?;
+        session.hello = session.handshake(&q, session.last_start, None)?;
         session.started = Instant::now();
         Ok(session)
     }
@@ -102,7 +107,7 @@ impl Session {
         self.check_hello(&hello)?;
         self.report.restarts += 1;
         let q = self.last_state.clone();
-        self.hello = self.handshake(&q, Some(hello))?;
+        self.hello = self.handshake(&q, Start::Given, Some(hello))?;
         self.hold()
     }
 
@@ -143,6 +148,10 @@ impl Session {
         self.report.count(&outcome);
         if let FrameOutcome::Tracked(state) = &outcome {
             self.last_state = state.q.to_vec();
+            self.last_start = match state.status {
+                WireStatus::Searching => Start::Search,
+                WireStatus::Tracking | WireStatus::Lost => Start::Given,
+            };
         }
         Ok(outcome)
     }
@@ -251,7 +260,7 @@ impl Session {
                 self.check_hello(&hello)?;
                 self.report.restarts += 1;
                 let q = self.last_state.clone();
-                self.hello = self.handshake(&q, Some(hello))?;
+                self.hello = self.handshake(&q, self.last_start, Some(hello))?;
                 FrameOutcome::Dropped(DropCause::BoardRestarted)
             }
             other => {
@@ -277,22 +286,24 @@ impl Session {
         Ok(())
     }
 
-    /// `Configure` then `Reset` from `q`, each until answered; returns the `Hello` that came
-    /// with the reset, or `known` (a `Hello` already received and checked) if that one was
-    /// lost on the line. Without either, the reset is repeated (it restarts from the same
-    /// state, so repeating is harmless).
-    fn handshake(&mut self, q: &[f32], known: Option<Hello>) -> Result<Hello> {
+    /// `Configure` then `Reset` from `q` (tracking from it, or searching: `start`), each until
+    /// answered; returns the `Hello` that came with the reset, or `known` (a `Hello` already
+    /// received and checked) if that one was lost on the line. Without either, the reset is
+    /// repeated (it restarts from the same state, so repeating is harmless).
+    fn handshake(&mut self, q: &[f32], start: Start, known: Option<Hello>) -> Result<Hello> {
         let configure = HostMessage::Configure(Configure {
             camera: self.setup.camera,
             tracker: self.setup.tracker,
             features_every: self.setup.features_every,
             stats_every: self.setup.stats_every,
+            search_evaluations_per_frame: self.setup.search_evaluations_per_frame,
         });
         self.command(&configure, Command::Configure)?;
         let q: HVec<f32, MAX_STATES> = q.iter().copied().take(MAX_STATES).collect();
         let reset = HostMessage::Reset(Reset {
             q,
             free: self.setup.free,
+            start,
         });
         for _ in 0..ATTEMPTS {
             if let Some(hello) = self.command(&reset, Command::Reset)?.or(known.clone()) {
@@ -370,8 +381,11 @@ impl Session {
 fn refusal_text(refusal: Refusal) -> &'static str {
     match refusal {
         Refusal::BadCamera => "the camera is unusable (size or focal length)",
-        Refusal::BadParameters => "a tracker parameter is out of range",
-        Refusal::FrameTooLarge => "the camera's frames do not fit the board's frame buffer",
+        Refusal::BadParameters => "a tracker parameter is out of range, or the search budget is 0",
+        Refusal::FrameTooLarge => {
+            "the camera's frames (or their edge map for the search) do not fit the board's \
+             buffers"
+        }
         Refusal::BadState => "the state has the wrong length for the model or is not finite",
         Refusal::BadFreeMask => "a free state is not a state of the model",
         Refusal::NotConfigured => "it has no camera yet (Reset or Hold before Configure)",
@@ -407,12 +421,25 @@ pub struct SetUpBoard {
 }
 
 /// Configures and resets the board on `link` from `path` (a `sequence.json`, or a sequence
-/// folder holding one), for camera `camera` of a multi-camera description; says so on `out`.
-/// For a board with its own camera: `listen --setup`, `ui --port --setup`.
+/// folder holding one), for camera `camera` of a multi-camera description, tracking from the
+/// initial state; says so on `out`. For a board with its own camera: `listen --setup`,
+/// `ui --port --setup`.
 pub fn set_up_board(
     link: Link,
     path: &Path,
     camera: Option<usize>,
+    out: &mut dyn Write,
+) -> Result<SetUpBoard> {
+    set_up_board_starting(link, path, camera, Start::Given, out)
+}
+
+/// [`set_up_board`], starting as `start` says: from the initial state, or searching for the
+/// hand (`listen --setup … --init auto`).
+pub fn set_up_board_starting(
+    link: Link,
+    path: &Path,
+    camera: Option<usize>,
+    start: Start,
     out: &mut dyn Write,
 ) -> Result<SetUpBoard> {
     let json = if path.is_dir() {
@@ -421,7 +448,9 @@ pub fn set_up_board(
         path.to_path_buf()
     };
     let sequence = Sequence::open_description(&json)?;
-    let session = Session::start(link, SessionSetup::from_sequence(&sequence, camera)?)?;
+    let mut setup = SessionSetup::from_sequence(&sequence, camera)?;
+    setup.start = start;
+    let session = Session::start(link, setup)?;
     writeln!(
         out,
         "board {} set up from {}",

@@ -4,7 +4,9 @@
 use std::time::Duration;
 
 use anyhow::{anyhow, bail, Result};
-use digiteyes_core::protocol::{model_digest, CameraParams, TrackerParams};
+use digiteyes_core::protocol::{
+    default_search_evaluations, model_digest, CameraParams, Start, TrackerParams,
+};
 
 use crate::sequence::Sequence;
 
@@ -26,6 +28,11 @@ pub struct SessionSetup {
     pub initial_state: Vec<f32>,
     /// Bit `i`: state `i` is estimated (`Reset`).
     pub free: u32,
+    /// How the board starts (`Reset`): tracking from `initial_state`, or searching for the
+    /// free states (the fixed ones keep `initial_state`'s values).
+    pub start: Start,
+    /// The board's search budget per frame, in evaluations (`Configure`).
+    pub search_evaluations_per_frame: u16,
     /// [`model_digest`] of the model the frames show; the board's must match.
     pub model_digest: u32,
     /// The model's name for messages (`sequence.json`'s `model`).
@@ -74,6 +81,8 @@ impl SessionSetup {
             stats_every: 0,
             initial_state: sequence.initial_state.iter().map(|&v| v as f32).collect(),
             free,
+            start: Start::Given,
+            search_evaluations_per_frame: default_search_evaluations(),
             model_digest: model_digest(&sequence.model),
             model_name: sequence.file.model.clone(),
             reply_timeout: DEFAULT_REPLY_TIMEOUT,

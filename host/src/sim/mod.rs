@@ -33,7 +33,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use digiteyes_core::protocol::Stats;
-use digiteyes_firmware::{Board, NoLed, Tracked, Uploads};
+use digiteyes_firmware::{edge_map_bytes, Board, Buffers, NoLed, Tracked, Uploads};
 use digiteyes_platform_linux::{MonotonicClock, TtySerial};
 use serialport::{SerialPort, TTYPort};
 
@@ -61,6 +61,9 @@ pub struct SimOptions {
     /// Bytes of the board's frame buffer: the largest frame it accepts (default VGA,
     /// 640 × 480).
     pub frame_buffer_bytes: usize,
+    /// Bytes of the search's edge map: enough for the largest frame
+    /// ([`digiteyes_firmware::edge_map_bytes`]; default VGA's, 115,200).
+    pub edge_map_bytes: usize,
     /// Line noise, if any.
     pub corruption: Option<Corruption>,
     /// Power-cycle the board once, right after it has received the first chunk of the frame
@@ -87,6 +90,7 @@ impl Default for SimOptions {
     fn default() -> Self {
         SimOptions {
             frame_buffer_bytes: 640 * 480,
+            edge_map_bytes: edge_map_bytes(640, 480),
             corruption: None,
             restart_after: None,
             frame_tap: None,
@@ -120,9 +124,18 @@ impl SimOptions {
         self
     }
 
-    /// With a frame buffer of `bytes`.
+    /// With a frame buffer of `bytes`, and an edge map for any frame that fits it.
     pub fn frame_buffer_bytes(mut self, bytes: usize) -> Self {
         self.frame_buffer_bytes = bytes;
+        // The largest map a frame of `bytes` pixels can need is a one-pixel-high frame's.
+        self.edge_map_bytes = edge_map_bytes(bytes, 1);
+        self
+    }
+
+    /// With buffers for frames of `width × height` px at most (frame and edge map).
+    pub fn max_frame(mut self, width: u32, height: u32) -> Self {
+        self.frame_buffer_bytes = width as usize * height as usize;
+        self.edge_map_bytes = edge_map_bytes(width as usize, height as usize);
         self
     }
 }
@@ -284,6 +297,7 @@ fn run(
         options.corruption.clone(),
     )));
     let mut frame_buffer = vec![0u8; options.frame_buffer_bytes];
+    let mut edge_map = vec![0u8; options.edge_map_bytes];
     let note = |f: &dyn Fn(&mut SimReport)| {
         if let Ok(mut r) = report.lock() {
             f(&mut r);
@@ -299,8 +313,11 @@ fn run(
         };
         let mut board = Board::new(
             SIM_BOARD_NAME,
-            &mut frame_buffer,
-            None,
+            Buffers {
+                frame: &mut frame_buffer,
+                overlay: None,
+                edge_map: &mut edge_map,
+            },
             SimPort {
                 line: line.clone(),
                 report: report.clone(),

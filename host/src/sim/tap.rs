@@ -8,6 +8,7 @@ use std::time::Duration;
 
 use digiteyes_core::camera::Camera;
 use digiteyes_core::features::FeatureConfig;
+use digiteyes_core::status::Status;
 use digiteyes_firmware::Tracked;
 
 use super::SimReport;
@@ -33,8 +34,11 @@ pub struct SimFrame {
     pub camera: Camera,
     /// The slice-search parameters, as configured (what an overlay needs to redraw the search).
     pub features: FeatureConfig,
-    /// The tracker flagged the state as not to be trusted.
+    /// The tracker flagged the state as not to be trusted (whenever `status` is not
+    /// `Tracking`).
     pub lost: bool,
+    /// What the board claimed of the frame (the `State` message's `status`).
+    pub status: Status,
     /// RMS image residual of the frame's last iteration (px).
     pub rms_px: f32,
     /// Gauss–Newton iterations run.
@@ -109,7 +113,8 @@ impl FrameTap {
             q: tracked.q.to_vec(),
             camera: *tracked.camera,
             features: tracked.config.features,
-            lost: tracked.report.lost,
+            lost: tracked.report.lost || !tracked.status.claims_hand(),
+            status: tracked.status,
             rms_px: tracked.report.rms_px,
             iterations: tracked.report.iterations,
             features_found: tracked.report.features_found,

@@ -42,6 +42,7 @@ fn feed(hub: &Hub, frames: &Receiver<SimFrame>) {
             frame: f.frame,
             q: f.q,
             lost: f.lost,
+            status: f.status,
             rms_px: f.rms_px,
             features_found: f.features_found,
             features_expected: f.features_expected,

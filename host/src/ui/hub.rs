@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::model::Model;
 use digiteyes_core::protocol::{BoardMessage, DropReason, LinkCounters, Stats};
+use digiteyes_core::status::Status;
 use image::GrayImage;
 use serde::Serialize;
 
@@ -29,8 +30,12 @@ pub struct ShownState {
     pub frame: u32,
     /// Every model state (quaternion, mm, rad).
     pub q: Vec<f32>,
-    /// The tracker does not trust this state.
+    /// The tracker does not trust this state (true whenever `status` is not `tracking`).
     pub lost: bool,
+    /// What the tracker claims of the frame, as its word: `searching`, `tracking` or `lost`
+    /// (the page shows the hand solid, ghosted or not at all).
+    #[serde(serialize_with = "status_word")]
+    pub status: Status,
     /// Residual RMS of the last iteration (px).
     pub rms_px: f32,
     /// Features found in the last iteration.
@@ -47,12 +52,18 @@ impl From<&digiteyes_core::protocol::State> for ShownState {
             frame: s.frame,
             q: s.q.to_vec(),
             lost: s.lost,
+            status: s.status.into(),
             rms_px: s.rms_px,
             features_found: s.features_found,
             features_expected: s.features_expected,
             iterations: s.iterations,
         }
     }
+}
+
+/// A status as its word in the page's JSON (`Status::as_str`).
+fn status_word<S: serde::Serializer>(status: &Status, serializer: S) -> Result<S::Ok, S::Error> {
+    serializer.serialize_str(status.as_str())
 }
 
 /// A camera frame waiting to be drawn with the model over it (drawn only when asked for).
@@ -86,8 +97,10 @@ pub struct LinkFigures {
     pub states: u64,
     /// States per second over the last [`RATE_WINDOW`].
     pub states_per_s: f64,
-    /// States the tracker flagged lost.
+    /// States the tracker flagged lost (searching ones included: no hand claimed).
     pub lost_states: u64,
+    /// States whose status was `searching`.
+    pub searching_states: u64,
     /// Frames not tracked, by reason.
     pub drops: BTreeMap<String, u64>,
     /// Total of `drops`.
@@ -221,6 +234,7 @@ impl Hub {
         inner.shapes = shapes;
         inner.link.states += 1;
         inner.link.lost_states += u64::from(state.lost);
+        inner.link.searching_states += u64::from(state.status == Status::Searching);
         inner.arrivals.push_back(now);
         while inner
             .arrivals
@@ -327,7 +341,7 @@ impl Hub {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use digiteyes_core::protocol::{Dropped, State};
+    use digiteyes_core::protocol::{Dropped, State, WireStatus};
 
     fn state(frame: u32, q: &[f32], lost: bool) -> BoardMessage {
         BoardMessage::State(State {
@@ -340,6 +354,12 @@ mod tests {
             features_expected: 35,
             iterations: 4,
             track_ticks: 100,
+            status: if lost {
+                WireStatus::Lost
+            } else {
+                WireStatus::Tracking
+            },
+            search_evaluations: 0,
         })
     }
 

@@ -11,11 +11,13 @@ use std::time::{Duration, Instant};
 use anyhow::{bail, Context, Result};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::protocol::BoardMessage;
+use digiteyes_core::status::Status;
 
 use super::hub::{CameraFrame, Hub, ShownState};
 use crate::link::Link;
 use crate::sequence::states::read_states_with_gaps;
 use crate::sequence::Sequence;
+use crate::stream::STATUS_COLUMN;
 
 /// Longest UDP datagram read (a `Features` message as JSON is a few KB).
 const MAX_DATAGRAM: usize = 65_536;
@@ -109,12 +111,15 @@ impl Replay {
         let expected = column("features_expected").unwrap_or_else(|| vec![0.0; rows]);
         let iterations = column("iterations").unwrap_or_else(|| vec![0.0; rows]);
         let dropped = table.extra_text("dropped");
+        let statuses = replay_statuses(table.extra_text(STATUS_COLUMN).as_deref(), &lost)
+            .with_context(|| format!("{}", states_csv.display()))?;
         let states = (0..rows)
             .map(|i| {
                 let shown = ShownState {
                     frame: i as u32,
                     q: table.table.rows[i].iter().map(|&v| v as f32).collect(),
-                    lost: lost[i] != 0.0,
+                    lost: lost[i] != 0.0 || !statuses[i].claims_hand(),
+                    status: statuses[i],
                     rms_px: rms[i] as f32,
                     features_found: found[i] as u16,
                     features_expected: expected[i] as u16,
@@ -225,6 +230,35 @@ impl Replay {
     }
 }
 
+/// Each frame's status: from the `status` column's words when the CSV has one, else from the
+/// `lost` column (a CSV written before the status existed: `lost` 1 → lost, else tracking).
+/// An empty field (e.g. a row a tool left blank) also falls back on `lost`.
+fn replay_statuses(words: Option<&[&str]>, lost: &[f64]) -> Result<Vec<Status>> {
+    let from_lost = |i: usize| {
+        if lost.get(i).is_some_and(|&l| l != 0.0) {
+            Status::Lost
+        } else {
+            Status::Tracking
+        }
+    };
+    let Some(words) = words else {
+        return Ok((0..lost.len()).map(from_lost).collect());
+    };
+    words
+        .iter()
+        .enumerate()
+        .map(|(i, word)| match *word {
+            "" => Ok(from_lost(i)),
+            word => Status::from_word(word).ok_or_else(|| {
+                anyhow::anyhow!(
+                    "frame {i}: status {} is not one of searching, tracking, lost",
+                    crate::text::quote_value(word)
+                )
+            }),
+        })
+        .collect()
+}
+
 /// A source's thread: runs `body` and, if it fails, keeps the error for the caller.
 pub fn spawn(
     name: &str,
@@ -235,4 +269,40 @@ pub fn spawn(
         .name(name.into())
         .spawn(move || body(&stop))
         .with_context(|| format!("cannot start the {name} thread"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn statuses_come_from_the_status_column_or_else_from_lost() {
+        let lost = [0.0, 1.0, 1.0, 0.0];
+        assert_eq!(
+            replay_statuses(None, &lost).unwrap(),
+            [
+                Status::Tracking,
+                Status::Lost,
+                Status::Lost,
+                Status::Tracking
+            ]
+        );
+        let words = ["tracking", "lost", "searching", ""];
+        assert_eq!(
+            replay_statuses(Some(&words), &lost).unwrap(),
+            [
+                Status::Tracking,
+                Status::Lost,
+                Status::Searching,
+                Status::Tracking
+            ]
+        );
+        let e = replay_statuses(Some(&["tracking", "Found"]), &lost)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("frame 1") && e.contains("Found") && e.contains("searching, tracking, lost"),
+            "{e}"
+        );
+    }
 }

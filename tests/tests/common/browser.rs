@@ -79,6 +79,8 @@ pub fn state_line(frame: u32, q: &[f32]) -> String {
         features_expected: 42,
         iterations: 3,
         track_ticks: 5000,
+        status: digiteyes_core::protocol::WireStatus::Tracking,
+        search_evaluations: 0,
     });
     format!("{}\n", serde_json::to_string(&message).unwrap())
 }

@@ -50,16 +50,36 @@ function shade(base, k) {
   return `rgb(${c[0]},${c[1]},${c[2]})`;
 }
 
+// How the hand is drawn for a status: solid while tracked; ghosted while lost (the board
+// holds the last good state); not at all while searching (the state is no estimate).
+function handLook(state) {
+  const status = trackStatus(state);
+  if (status === "searching") return "hidden";
+  return status === "lost" ? "ghost" : "solid";
+}
+
+// A state's status word; a state without one (an older source) is lost or tracking.
+function trackStatus(state) {
+  if (!state) return "";
+  if (state.status) return state.status;
+  return state.lost ? "lost" : "tracking";
+}
+
 function drawHand() {
   const canvas = $("hand3d");
   const ctx = canvas.getContext("2d");
   ctx.fillStyle = "#e9edf2";
   ctx.fillRect(0, 0, canvas.width, canvas.height);
   const shapes = (snap && snap.shapes) || [];
-  if (!shapes.length) {
+  const look = snap && snap.state ? handLook(snap.state) : "solid";
+  document.body.dataset.hand = shapes.length ? look : "none";
+  if (!shapes.length || look === "hidden") {
     ctx.fillStyle = "#667";
     ctx.font = "16px sans-serif";
-    ctx.fillText(snap && snap.state ? "the state does not fit the model" : "waiting for states…", 20, 30);
+    ctx.fillText(
+      !snap || !snap.state ? "waiting for states…"
+        : look === "hidden" ? "searching for the hand…" : "the state does not fit the model",
+      20, 30);
     document.body.dataset.shapesDrawn = "0";
     return;
   }
@@ -140,7 +160,15 @@ function drawHand() {
     }
   }
   items.sort((p, q) => q.depth - p.depth);
+  ctx.save();
+  if (look === "ghost") ctx.globalAlpha = 0.3;
   for (const it of items) it.draw();
+  ctx.restore();
+  if (look === "ghost") {
+    ctx.fillStyle = "#c0392b";
+    ctx.font = "16px sans-serif";
+    ctx.fillText("lost: the last good state, held", 20, 30);
+  }
   document.body.dataset.shapesDrawn = String(shapes.length);
 }
 
@@ -406,10 +434,15 @@ function setLink(rows) {
 function updatePanels() {
   const s = snap.state;
   const status = $("status");
+  const word = trackStatus(s);
+  document.body.dataset.status = word;
   if (snap.no_signal) {
     status.className = "badge nosignal";
     status.textContent = s ? "NO SIGNAL" : "WAITING";
-  } else if (s && s.lost) {
+  } else if (word === "searching") {
+    status.className = "badge searching";
+    status.textContent = "SEARCHING";
+  } else if (word === "lost") {
     status.className = "badge lost";
     status.textContent = "LOST TRACK";
   } else {
@@ -417,7 +450,7 @@ function updatePanels() {
     status.textContent = "TRACKING";
   }
   $("frame").textContent = s
-    ? `frame ${s.frame} · rms ${Number.isFinite(s.rms_px) ? s.rms_px.toFixed(2) : "–"} px · ` +
+    ? `frame ${s.frame} · ${word} · rms ${Number.isFinite(s.rms_px) ? s.rms_px.toFixed(2) : "–"} px · ` +
       `${s.features_found}/${s.features_expected} features · ${s.iterations} iterations`
     : "no state yet";
   document.body.dataset.frame = s ? String(s.frame) : "";
@@ -427,7 +460,8 @@ function updatePanels() {
   const rows = [
     ["states received", l.states],
     ["states/s (last 2 s)", l.states_per_s.toFixed(1)],
-    ["lost-track states", l.lost_states],
+    ["lost-track states (searching included)", l.lost_states],
+    ["searching states", l.searching_states],
     ["frames dropped", l.dropped],
   ];
   for (const [why, n] of Object.entries(l.drops)) rows.push([` · ${why}`, n]);

@@ -1,0 +1,208 @@
+//! The board's status through the `digiteyes` command (protocol version 4): `listen` prints
+//! each state's status and counts them; `stream --init auto` has a simulated board (the
+//! firmware's loop) search for the hand, and its CSV says so in a `status` column.
+
+mod common;
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::process::{Command, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use digiteyes_core::protocol::{encode, BoardMessage, State, WireStatus, MAX_MESSAGE};
+use digiteyes_host::sim::{self, SimOptions};
+use serialport::{SerialPort, TTYPort};
+
+/// Kills and reaps a child process when dropped, so a failing test leaves none behind.
+struct Reap(std::process::Child);
+
+impl Drop for Reap {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn state(frame: u32, status: WireStatus) -> BoardMessage {
+    let tracking = status == WireStatus::Tracking;
+    BoardMessage::State(State {
+        frame,
+        timestamp: 1000 * u64::from(frame),
+        q: [1.0, 0.0, 0.0, 0.0, 1.5, -2.0, 600.0].into_iter().collect(),
+        rms_px: 0.5,
+        lost: !tracking,
+        features_found: 20,
+        features_expected: 24,
+        iterations: 5,
+        track_ticks: 1234,
+        status,
+        search_evaluations: if status == WireStatus::Searching {
+            977
+        } else {
+            0
+        },
+    })
+}
+
+#[test]
+fn listen_prints_each_states_status_and_counts_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut board, slave) = TTYPort::pair().unwrap();
+    let path = slave.name().unwrap();
+    let mut listen = Reap(
+        Command::new(env!("CARGO_BIN_EXE_digiteyes"))
+            .args(["listen", "--port", &path, "--states", "4"])
+            .current_dir(dir.path())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap(),
+    );
+    // Every stderr line, as it comes: the first says the port is open.
+    let (tx, rx) = mpsc::channel();
+    let stderr = listen.0.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+    let opened = rx.recv_timeout(Duration::from_secs(30)).unwrap();
+    assert!(opened.contains("listening on"), "{opened}");
+
+    let mut bytes = Vec::new();
+    for (frame, status) in [
+        (7, WireStatus::Searching),
+        (8, WireStatus::Tracking),
+        (9, WireStatus::Lost),
+        (10, WireStatus::Searching),
+    ] {
+        let mut buf = [0u8; MAX_MESSAGE];
+        bytes.extend_from_slice(encode(&state(frame, status), &mut buf).unwrap());
+    }
+    board.write_all(&bytes).unwrap();
+
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while listen.0.try_wait().unwrap().is_none() {
+        assert!(
+            Instant::now() < deadline,
+            "listen did not stop after 4 states"
+        );
+        // Polling for the child's exit, which it reaches by itself after four states.
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert!(listen.0.wait().unwrap().success());
+    let mut printed = String::new();
+    listen
+        .0
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut printed)
+        .unwrap();
+    reader.join().unwrap();
+    let summary: Vec<String> = rx.try_iter().collect();
+    let lines: Vec<&str> = printed.lines().collect();
+    assert_eq!(lines.len(), 4, "{printed}");
+    assert!(
+        lines[0].starts_with("state 7 searching (977 evaluations): "),
+        "{}",
+        lines[0]
+    );
+    assert!(lines[1].starts_with("state 8 tracking: "), "{}", lines[1]);
+    assert!(lines[2].starts_with("state 9 lost: ") && lines[2].contains("LOST"));
+    assert!(lines[3].starts_with("state 10 searching "), "{}", lines[3]);
+    assert!(
+        summary
+            .iter()
+            .any(|l| l.contains("4 states: 1 tracking, 1 lost, 2 searching")),
+        "{summary:?}"
+    );
+}
+
+#[test]
+fn stream_init_auto_has_a_simulated_board_search_and_writes_the_status() {
+    let dir = tempfile::tempdir().unwrap();
+    common::small_sequence(dir.path(), "mouse", 3);
+    let board = sim::start(SimOptions::default()).unwrap();
+    let port = board.path().display().to_string();
+    let out = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
+        .args([
+            "stream", "--port", &port, "--seq", "mouse", "--init", "auto",
+        ])
+        .args(["--out", "s.csv", "--quiet"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let report = board.stop().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && stdout.contains("3 tracked"),
+        "every frame answered:\n{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(report.board.frames, 3, "{report:?}");
+    let csv = std::fs::read_to_string(dir.path().join("s.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(&header[header.len() - 3..], ["lost", "dropped", "status"]);
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3);
+    // The first frame of a search can only search; later ones may have found the hand.
+    assert_eq!(&rows[0][rows[0].len() - 3..], ["1", "", "searching"]);
+    for row in &rows {
+        let tail = &row[row.len() - 3..];
+        assert_eq!(tail[0] == "1", tail[2] != "tracking", "{row:?}");
+    }
+    let searching = rows
+        .iter()
+        .filter(|r| r.last() == Some(&"searching"))
+        .count();
+    assert!(
+        stdout.contains(&format!("{searching} searching")),
+        "the summary counts the statuses: {stdout}"
+    );
+
+    // Without --init auto the same board tracks from the initial state.
+    let board = sim::start(SimOptions::default()).unwrap();
+    let port = board.path().display().to_string();
+    let out = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
+        .args(["stream", "--port", &port, "--seq", "mouse"])
+        .args(["--out", "given.csv", "--quiet"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    board.stop().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.path().join("given.csv")).unwrap();
+    assert!(
+        csv.lines().skip(1).all(|l| l.ends_with(",0,,tracking")),
+        "{csv}"
+    );
+}
+
+#[test]
+fn init_auto_with_one_board_per_camera_is_refused_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
+        .args([
+            "stream",
+            "--port",
+            "/nonexistent/a",
+            "--port",
+            "/nonexistent/b",
+        ])
+        .args(["--seq", "stereo", "--init", "auto"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("--init auto") && stderr.contains("accepted: --init given"),
+        "{stderr}"
+    );
+}
