@@ -380,9 +380,13 @@ impl AutoTracker {
                 return Ok((0.0, q, report));
             }
         }
-        let score =
-            self.acquirer
-                .score(self.tracker.model(), self.tracker.cameras(), frames, maps, &q);
+        let score = self.acquirer.score(
+            self.tracker.model(),
+            self.tracker.cameras(),
+            frames,
+            maps,
+            &q,
+        );
         Ok((score, q, report))
     }
 

@@ -23,8 +23,8 @@ use digiteyes_core::tracker::{Tracker, TrackerConfig};
 
 use crate::acquire::{AutoTracker, Recovery, Status};
 use crate::overlay::{draw_overlay, overlay_path, PngStats, PngWriter};
-use crate::sequence::{Sequence, StatesWriter};
 pub use crate::sequence::status::{StatusCounts, STATUS_COLUMN};
+use crate::sequence::{Sequence, StatesWriter};
 
 /// How `track` starts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -247,8 +247,7 @@ pub fn track_sequence_opts(
     sequence.check_cameras_see_the_hand(&(0..sequence.cameras.len()).collect::<Vec<_>>())?;
     let init = options.init.unwrap_or(Init::default_for(&sequence));
     let mut tracker = sequence_auto_tracker(&sequence, config, options)?;
-    let mut writer =
-        StatesWriter::with_columns(out_csv, sequence.n_states(), &[STATUS_COLUMN])?;
+    let mut writer = StatesWriter::with_columns(out_csv, sequence.n_states(), &[STATUS_COLUMN])?;
     let mut overlays = overlay_dir.map(|_| PngWriter::start(8)).transpose()?;
     let bar = crate::progress::bar(sequence.frames, "track", progress);
     let mut tracking = Duration::ZERO;
@@ -273,7 +272,10 @@ pub fn track_sequence_opts(
             let files: Vec<String> = (0..sequence.cameras.len())
                 .map(|c| sequence.frame_path(c, k).display().to_string())
                 .collect();
-            anyhow!("frame {k} ({}): the tracker failed: {e:#}", files.join(", "))
+            anyhow!(
+                "frame {k} ({}): the tracker failed: {e:#}",
+                files.join(", ")
+            )
         })?;
         let report = auto.report;
         writer

@@ -36,8 +36,8 @@ fn track_err(seq: &Path, out: &Path, init: Option<Init>) -> String {
         init,
         ..TrackOptions::default()
     };
-    let err = track_sequence_opts(seq, out, TrackerConfig::default(), false, None, &options)
-        .unwrap_err();
+    let err =
+        track_sequence_opts(seq, out, TrackerConfig::default(), false, None, &options).unwrap_err();
     format!("{err:#}")
 }
 
@@ -85,20 +85,27 @@ fn init_auto_ignores_the_given_free_states_and_starts_searching() {
     );
     let table = read_states(&a, sequence.n_states()).unwrap();
     let status = table.status.clone().expect("a status column");
-    assert_eq!(status[0], Some(Status::Searching), "--init auto starts searching");
+    assert_eq!(
+        status[0],
+        Some(Status::Searching),
+        "--init auto starts searching"
+    );
     // While searching, the states are the search's base: the fixed states as given, the free
     // ones not the given values.
     let base = sequence.search_base();
     for (k, row) in table.rows.iter().enumerate() {
         if status[k] == Some(Status::Searching) {
             for (s, (v, b)) in row.iter().zip(&base).enumerate() {
-                assert!((v - b).abs() < 1e-4, "frame {k} q{s}: {v} is not the base {b}");
+                assert!(
+                    (v - b).abs() < 1e-4,
+                    "frame {k} q{s}: {v} is not the base {b}"
+                );
             }
         }
     }
-    for s in 0..sequence.n_states() {
+    for (s, (b, given)) in base.iter().zip(&sequence.initial_state).enumerate() {
         if !free.contains(&s) && s >= 4 {
-            assert_eq!(base[s], sequence.initial_state[s], "fixed q{s} keeps its value");
+            assert_eq!(b, given, "fixed q{s} keeps its value");
         }
     }
     // --init given does start from the given state: the two runs then differ.
@@ -116,13 +123,20 @@ fn a_sequence_without_initial_state_is_searched_with_status_and_lost_right() {
     let dir = tempfile::tempdir().unwrap();
     let seq = render(dir.path(), "rigid", 3, true);
     let text = std::fs::read_to_string(seq.join("sequence.json")).unwrap();
-    assert!(!text.contains("initial_state") && !text.contains("\"free\""), "{text}");
+    assert!(
+        !text.contains("initial_state") && !text.contains("\"free\""),
+        "{text}"
+    );
     let sequence = Sequence::open(&seq).unwrap();
     assert!(!sequence.initial_given);
     assert_eq!(sequence.free_states().len(), sequence.n_states());
     let out = dir.path().join("states.csv");
     let summary = track(&seq, &out, None);
-    assert_eq!(summary.init, Init::Auto, "the default without an initial state");
+    assert_eq!(
+        summary.init,
+        Init::Auto,
+        "the default without an initial state"
+    );
     assert_eq!(summary.frames, 3);
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(
@@ -135,14 +149,35 @@ fn a_sequence_without_initial_state_is_searched_with_status_and_lost_right() {
     assert_eq!(status[0], Some(Status::Searching));
     for k in 0..table.rows.len() {
         let claimed = status[k] == Some(Status::Tracking);
-        assert_eq!(lost[k] == 0.0, claimed, "frame {k}: lost {} with status {:?}", lost[k], status[k]);
-        assert!(table.rows[k].iter().all(|v| v.is_finite()), "frame {k}: NaN");
+        assert_eq!(
+            lost[k] == 0.0,
+            claimed,
+            "frame {k}: lost {} with status {:?}",
+            lost[k],
+            status[k]
+        );
+        assert!(
+            table.rows[k].iter().all(|v| v.is_finite()),
+            "frame {k}: NaN"
+        );
     }
-    assert_eq!(summary.lost_frames, status.iter().filter(|s| **s != Some(Status::Tracking)).count());
-    assert_eq!(summary.status.searching + summary.status.tracking + summary.status.lost, 3);
+    assert_eq!(
+        summary.lost_frames,
+        status
+            .iter()
+            .filter(|s| **s != Some(Status::Tracking))
+            .count()
+    );
+    assert_eq!(
+        summary.status.searching + summary.status.tracking + summary.status.lost,
+        3
+    );
     // eval reads the file, with and without its status column.
     let report = digiteyes_host::evaluate(&seq, &out).unwrap();
-    assert_eq!(report.status.as_ref().unwrap().searching, summary.status.searching);
+    assert_eq!(
+        report.status.as_ref().unwrap().searching,
+        summary.status.searching
+    );
     let stripped = dir.path().join("old.csv");
     let old: String = text
         .lines()
@@ -162,7 +197,8 @@ fn malformed_cases_are_refused_with_clear_errors() {
     edit_json(&seq, |file| file.initial_state.clear());
     let err = format!("{:#}", Sequence::open(&seq).unwrap_err());
     assert!(
-        err.contains("`initial_state` is absent") && err.contains("`free` lists 7 of the model's 28"),
+        err.contains("`initial_state` is absent")
+            && err.contains("`free` lists 7 of the model's 28"),
         "{err}"
     );
     let out = dir.path().join("states.csv");
@@ -184,6 +220,12 @@ fn malformed_cases_are_refused_with_clear_errors() {
         ..RenderOptions::default()
     };
     let bad = dir.path().join("bad");
-    let err = format!("{:#}", render_scenario("mouse", &bad, &options).unwrap_err());
-    assert!(err.contains("blackout 2..9") && err.contains("<= 4"), "{err}");
+    let err = format!(
+        "{:#}",
+        render_scenario("mouse", &bad, &options).unwrap_err()
+    );
+    assert!(
+        err.contains("blackout 2..9") && err.contains("<= 4"),
+        "{err}"
+    );
 }

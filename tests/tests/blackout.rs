@@ -40,7 +40,10 @@ fn frames(sequence: &Sequence, k: usize) -> Vec<image::GrayImage> {
 }
 
 fn palm_error_mm(truth: &[f64], q: &[f64]) -> f64 {
-    (4..7).map(|i| (truth[i] - q[i]).powi(2)).sum::<f64>().sqrt()
+    (4..7)
+        .map(|i| (truth[i] - q[i]).powi(2))
+        .sum::<f64>()
+        .sqrt()
 }
 
 #[test]
@@ -62,11 +65,20 @@ fn after_a_blackout_the_hand_is_lost_searched_and_found_again_within_30_frames()
     let sequence = Sequence::open(&seq).unwrap();
     let table = read_states(&out, sequence.n_states()).unwrap();
     let truth = sequence.read_truth().unwrap();
-    let status: Vec<Status> = table.status.unwrap().into_iter().map(Option::unwrap).collect();
+    let status: Vec<Status> = table
+        .status
+        .unwrap()
+        .into_iter()
+        .map(Option::unwrap)
+        .collect();
     let word = |s: &[Status]| s.iter().map(|s| &s.as_str()[..1]).collect::<String>();
     println!("{}", word(&status));
     // Tracked up to the blackout, then lost, then searching, never claimed in the dark.
-    assert!(status[..a].iter().all(|&s| s == Status::Tracking), "{}", word(&status));
+    assert!(
+        status[..a].iter().all(|&s| s == Status::Tracking),
+        "{}",
+        word(&status)
+    );
     assert_eq!(status[a], Status::Lost, "the first dark frame is lost");
     let searching = a + LOST_FRAMES_BEFORE_SEARCH as usize - 1;
     assert!(status[a..searching].iter().all(|&s| s == Status::Lost));
@@ -75,17 +87,22 @@ fn after_a_blackout_the_hand_is_lost_searched_and_found_again_within_30_frames()
     let back = (b..n)
         .find(|&k| status[k] == Status::Tracking)
         .expect("never re-acquired");
-    assert!(back < b + 30, "re-acquired at frame {back}, {} after its return", back - b);
+    assert!(
+        back < b + 30,
+        "re-acquired at frame {back}, {} after its return",
+        back - b
+    );
     assert_eq!(summary.status.reacquired, vec![back]);
     assert_eq!(summary.status.lost_at, vec![a]);
-    for k in back + 5..n {
-        assert_eq!(status[k], Status::Tracking, "frame {k}");
-        let e = palm_error_mm(&truth.rows[k], &table.rows[k]);
+    let after = status.iter().zip(&truth.rows).zip(&table.rows).enumerate();
+    for (k, ((s, t), q)) in after.skip(back + 5) {
+        assert_eq!(*s, Status::Tracking, "frame {k}");
+        let e = palm_error_mm(t, q);
         assert!(e < 10.0, "frame {k}: palm {e:.1} mm from the truth");
     }
     // While searching, the states hold the last tracked one.
-    for k in searching..back {
-        assert_eq!(table.rows[k], table.rows[a - 1], "frame {k}");
+    for (k, row) in table.rows.iter().enumerate().take(back).skip(searching) {
+        assert_eq!(row, &table.rows[a - 1], "frame {k}");
     }
 }
 
@@ -97,15 +114,22 @@ fn frames_without_the_hand_are_never_claimed() {
     let (a, n) = (3, 3 + 10 + 70);
     let seq = render(dir.path(), n, a..n);
     let sequence = Sequence::open(&seq).unwrap();
-    let mut auto =
-        sequence_auto_tracker(&sequence, TrackerConfig::default(), &TrackOptions::default())
-            .unwrap();
+    let mut auto = sequence_auto_tracker(
+        &sequence,
+        TrackerConfig::default(),
+        &TrackOptions::default(),
+    )
+    .unwrap();
     let (mut local, mut global, mut refused) = (0, 0, 0);
     for k in 0..n {
         let images = frames(&sequence, k);
         let r = auto.step(&views(&images)).unwrap();
         if k >= a {
-            assert_ne!(r.status, Status::Tracking, "hand-free frame {k} claimed a hand");
+            assert_ne!(
+                r.status,
+                Status::Tracking,
+                "hand-free frame {k} claimed a hand"
+            );
             assert!(r.report.lost, "frame {k}");
         }
         local += usize::from(r.local);
@@ -113,7 +137,10 @@ fn frames_without_the_hand_are_never_claimed() {
         refused += usize::from(r.leaf_score.is_some());
     }
     println!("{local} local frames, {global} global, {refused} hypotheses refused");
-    assert!(local >= 50, "the local re-acquisition must have run: {local}");
+    assert!(
+        local >= 50,
+        "the local re-acquisition must have run: {local}"
+    );
     assert!(global >= 5, "the global search must have run: {global}");
 }
 
@@ -145,7 +172,10 @@ fn the_status_machine_tracks_bit_for_bit_as_the_tracker_while_not_lost() {
         let images = frames(&sequence, k);
         let expected = plain.track(&views(&images)).unwrap();
         let got = auto.step(&views(&images)).unwrap();
-        assert!(!expected.lost, "frame {k}: the test needs a sequence never lost");
+        assert!(
+            !expected.lost,
+            "frame {k}: the test needs a sequence never lost"
+        );
         assert_eq!(got.report, expected, "frame {k}");
         assert_eq!(got.status, Status::Tracking);
         let bits = |q: &[f32]| q.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
@@ -172,7 +202,11 @@ fn recover_never_writes_the_plain_trackers_states_through_a_blackout() {
         let got = auto.step(&views(&images)).unwrap();
         assert_eq!(got.report, expected, "frame {k}");
         assert_eq!(auto.state(), plain.state(), "frame {k}");
-        assert_ne!(got.status, Status::Searching, "frame {k}: --recover never searched");
+        assert_ne!(
+            got.status,
+            Status::Searching,
+            "frame {k}: --recover never searched"
+        );
         lost_run = if expected.lost { lost_run + 1 } else { 0 };
         longest = longest.max(lost_run);
         assert_eq!(got.status == Status::Lost, expected.lost, "frame {k}");

@@ -113,10 +113,7 @@ pub fn evaluate(seq: &Path, states_csv: &Path) -> Result<EvalReport> {
     report.set_acquisitions(&estimated.claimed());
     report.status = estimated.status.as_ref().map(|column| {
         // A frame with no status (a board's dropped frame) claims nothing: counted as lost.
-        let statuses: Vec<Status> = column
-            .iter()
-            .map(|s| s.unwrap_or(Status::Lost))
-            .collect();
+        let statuses: Vec<Status> = column.iter().map(|s| s.unwrap_or(Status::Lost)).collect();
         StatusCounts::of(&statuses)
     });
     Ok(report)
@@ -255,28 +252,6 @@ pub fn acquisitions(errors: &[f64], claimed: &[bool]) -> (Option<usize>, Vec<usi
     (first, again)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn acquisitions_need_five_good_claimed_frames() {
-        let e = |v: &[f64]| v.to_vec();
-        // Held from frame 2; a 5-frame loss; held again from frame 12.
-        let errors = e(&[50., 50., 1., 1., 1., 1., 1., 50., 50., 50., 50., 50., 1., 1., 1., 1., 1.]);
-        let all = vec![true; errors.len()];
-        assert_eq!(acquisitions(&errors, &all), (Some(2), vec![12]));
-        // Unclaimed frames are not held, whatever their error.
-        let mut claimed = all.clone();
-        claimed[3] = false;
-        assert_eq!(acquisitions(&errors, &claimed).0, Some(4));
-        // A loss shorter than five frames is no re-acquisition.
-        let errors = e(&[1., 1., 1., 1., 1., 50., 50., 1., 1., 1., 1., 1.]);
-        assert_eq!(acquisitions(&errors, &vec![true; 12]), (Some(0), vec![]));
-        assert_eq!(acquisitions(&[50.; 8], &[true; 8]), (None, vec![]));
-    }
-}
-
 /// Fraction of frames before the first run of [`LOST_RUN`] frames whose error (px) all exceed
 /// [`LOST_ERROR_PX`]; 1 if there is no such run.
 pub fn track_life(errors: &[f64]) -> f64 {
@@ -309,4 +284,30 @@ fn to_f32(q: &[f64]) -> Vec<f32> {
 
 fn unit(q: &[f32]) -> [f32; 4] {
     quaternion::normalised([q[0], q[1], q[2], q[3]]).unwrap_or([1.0, 0.0, 0.0, 0.0])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn acquisitions_need_five_good_claimed_frames() {
+        let e = |v: &[f64]| v.to_vec();
+        // Held from frame 2; a 5-frame loss; held again from frame 12.
+        let errors = e(&[
+            50., 50., 1., 1., 1., 1., 1., 50., 50., 50., 50., 50., 1., 1., 1., 1., 1.,
+        ]);
+        let all = vec![true; errors.len()];
+        assert_eq!(acquisitions(&errors, &all), (Some(2), vec![12]));
+        // Unclaimed frames are not held, whatever their error.
+        let errors = e(&[50., 50., 1., 1., 1., 1., 1., 1., 1.]);
+        let mut claimed = vec![true; errors.len()];
+        assert_eq!(acquisitions(&errors, &claimed).0, Some(2));
+        claimed[3] = false;
+        assert_eq!(acquisitions(&errors, &claimed).0, Some(4));
+        // A loss shorter than five frames is no re-acquisition.
+        let errors = e(&[1., 1., 1., 1., 1., 50., 50., 1., 1., 1., 1., 1.]);
+        assert_eq!(acquisitions(&errors, &[true; 12]), (Some(0), vec![]));
+        assert_eq!(acquisitions(&[50.; 8], &[true; 8]), (None, vec![]));
+    }
 }

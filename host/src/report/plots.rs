@@ -3,10 +3,10 @@
 //! error over time.
 
 use super::accuracy::Accuracy;
-use crate::sequence::status::Status;
 use super::input::Inputs;
 use super::svg::{finite_range, Chart, LegendEntry};
 use crate::eval::LOST_ERROR_PX;
+use crate::sequence::status::Status;
 use crate::state_names::{state_label, state_unit};
 
 /// The plot of state `state` (model index) against time: `<svg class="state-plot"
@@ -150,7 +150,12 @@ pub(super) fn decorate(chart: &mut Chart, inputs: &Inputs) -> Vec<LegendEntry> {
                 } else {
                     format!("frames {a}–{b} {status}")
                 };
-                chart.strip(inputs.times[a] - half, inputs.times[b] + half, class, &title);
+                chart.strip(
+                    inputs.times[a] - half,
+                    inputs.times[b] + half,
+                    class,
+                    &title,
+                );
             }
             if !runs.is_empty() {
                 legend.push(entry(class, status.as_str()));

@@ -186,8 +186,7 @@ pub fn generate_from(scenario: Scenario, opts: &RenderOptions) -> Result<Generat
         } else {
             truth[0].clone()
         },
-        free: (!opts.no_initial_state)
-            .then(|| scenario.free.iter().map(|&s| s as i64).collect()),
+        free: (!opts.no_initial_state).then(|| scenario.free.iter().map(|&s| s as i64).collect()),
     };
     let clutter = opts.clutter.unwrap_or(scenario.clutter);
     let settings = RenderSettings {

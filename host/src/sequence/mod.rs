@@ -376,7 +376,11 @@ pub fn base_state(model: &Model, cameras: &[Camera]) -> Vec<f64> {
     for (d, c) in q.iter_mut().skip(4).take(3).zip(volume.centre_mm) {
         *d = f64::from(c);
     }
-    for (s, v) in q.iter_mut().enumerate().skip(digiteyes_core::model::BASE_STATES) {
+    for (s, v) in q
+        .iter_mut()
+        .enumerate()
+        .skip(digiteyes_core::model::BASE_STATES)
+    {
         if let Some(l) = model.limit(s) {
             *v = f64::from(0.0f32.clamp(l.lo, l.hi));
         }

@@ -48,7 +48,10 @@ impl StateTable {
     /// (tracking), else from `lost` (0), else every frame.
     pub fn claimed(&self) -> Vec<bool> {
         if let Some(status) = &self.status {
-            return status.iter().map(|s| s.is_some_and(Status::claims_hand)).collect();
+            return status
+                .iter()
+                .map(|s| s.is_some_and(Status::claims_hand))
+                .collect();
         }
         match self.extra("lost") {
             Some(lost) => lost.iter().map(|&v| v == 0.0).collect(),

@@ -92,4 +92,3 @@ impl fmt::Display for StatusCounts {
         Ok(())
     }
 }
-
