@@ -104,6 +104,22 @@ fn after_a_blackout_the_hand_is_lost_searched_and_found_again_within_30_frames()
     for (k, row) in table.rows.iter().enumerate().take(back).skip(searching) {
         assert_eq!(row, &table.rows[a - 1], "frame {k}");
     }
+    // eval sees the acquisition at frame 0 and the re-acquisition; the report draws the band.
+    let report = digiteyes_host::evaluate(&seq, &out).unwrap();
+    println!("{report}");
+    assert_eq!(report.frames_to_acquire, Some(0));
+    assert_eq!(report.reacquired_at.len(), 1, "{:?}", report.reacquired_at);
+    assert!(report.reacquired_at[0] >= back && report.reacquired_at[0] < b + 30);
+    assert_eq!(report.status.unwrap().reacquired, vec![back]);
+    let mut options = digiteyes_host::report::ReportOptions::default();
+    options.thumb_every = 0;
+    let (html, _) = digiteyes_host::report::build_report(&seq, &out, &options).unwrap();
+    for class in ["status-searching", "status-tracking", "status-lost"] {
+        assert!(
+            html.contains(&format!(r#"<rect class="{class}""#)),
+            "no {class} band"
+        );
+    }
 }
 
 #[test]
