@@ -5,7 +5,8 @@ use anyhow::{anyhow, Result};
 use digiteyes_core::acquire::AcquireConfig;
 use digiteyes_core::auto_tracker::AutoTracker as CoreAutoTracker;
 pub use digiteyes_core::auto_tracker::{
-    AutoReport, Status, DEFAULT_ACCEPT_SCORE, FALLBACK_DEPTH_MM, LOST_FRAMES_BEFORE_SEARCH,
+    AutoReport, Recovery, Status, DEFAULT_ACCEPT_SCORE, FALLBACK_DEPTH_MM, LOCAL_REFINE_PASSES,
+    LOCAL_SEARCH_FRAMES, LOCAL_WINDOW, LOST_FRAMES_BEFORE_SEARCH,
 };
 use digiteyes_core::camera::Camera;
 use digiteyes_core::estimator::FreeMask;
@@ -32,14 +33,38 @@ impl AutoTracker {
     ) -> Result<Self> {
         let inner = CoreAutoTracker::new(model, cameras, base, free, config, acquire)
             .map_err(|e| anyhow!("cannot start the tracker: {e}"))?;
+        Ok(Self::with_buffers(inner, cameras, &acquire))
+    }
+
+    /// A tracker for `model` seen by `cameras` that starts by tracking from `initial` (the
+    /// state of the first frame), and searches only once the hand is lost.
+    pub fn tracking(
+        model: Model,
+        cameras: &[Camera],
+        initial: &[f32],
+        free: FreeMask,
+        config: TrackerConfig,
+        acquire: AcquireConfig,
+    ) -> Result<Self> {
+        let inner = CoreAutoTracker::tracking(model, cameras, initial, free, config, acquire)
+            .map_err(|e| anyhow!("cannot start the tracker: {e}"))?;
+        Ok(Self::with_buffers(inner, cameras, &acquire))
+    }
+
+    fn with_buffers(inner: CoreAutoTracker, cameras: &[Camera], acquire: &AcquireConfig) -> Self {
         let edge_buffers = cameras
             .iter()
-            .map(|c| vec![0u8; CoreAutoTracker::edge_bytes_needed(c, &acquire)])
+            .map(|c| vec![0u8; CoreAutoTracker::edge_bytes_needed(c, acquire)])
             .collect();
-        Ok(AutoTracker {
+        AutoTracker {
             inner,
             edge_buffers,
-        })
+        }
+    }
+
+    /// Sets what happens once the hand is lost for [`LOST_FRAMES_BEFORE_SEARCH`] frames.
+    pub fn set_recovery(&mut self, recovery: Recovery) {
+        self.inner.set_recovery(recovery);
     }
 
     /// Sets the score a refined leaf needs to be accepted.

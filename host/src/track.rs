@@ -1,10 +1,14 @@
-//! Tracking a recorded sequence with the core tracker.
+//! Tracking a recorded sequence with the core tracker, inside the status machine of
+//! [`crate::acquire::AutoTracker`] (Searching → Tracking → Lost → Searching).
 //!
-//! The tracker starts from `initial_state`, estimates the `free` states, and sees every frame
-//! of every camera: one `track` call per instant with one frame per camera. Each instant's
-//! state and report go to the output CSV (written beside it and put in place when every frame
-//! is tracked, so a failed run leaves an earlier file untouched; header
-//! `frame,q0..q{n-1},rms_px,iterations,features_found,features_expected,lost`).
+//! With [`Init::Given`] the tracker starts tracking from `initial_state`; with [`Init::Auto`]
+//! it starts searching for the hand (the free states' given values unused). It estimates the
+//! `free` states and sees every frame of every camera: one step per instant with one frame per
+//! camera. Each instant's state, report and status go to the output CSV (written beside it and
+//! put in place when every frame is tracked, so a failed run leaves an earlier file untouched;
+//! header `frame,q0..q{n-1},rms_px,iterations,features_found,features_expected,lost,status`).
+//! `lost` is 1 on every frame that claims no hand (searching or lost); while searching, the
+//! states are the last tracked ones (the search's base state before the first acquisition).
 //! Optionally each frame of each camera is also drawn with the model, the slices searched and
 //! the features found at the state tracked for it ([`crate::overlay`]), as PNGs.
 
@@ -12,12 +16,58 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
+use digiteyes_core::acquire::AcquireConfig;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
 
+use crate::acquire::{AutoTracker, Recovery, Status};
 use crate::overlay::{draw_overlay, overlay_path, PngStats, PngWriter};
+pub use crate::sequence::status::{StatusCounts, STATUS_COLUMN};
 use crate::sequence::{Sequence, StatesWriter};
+
+/// How `track` starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Init {
+    /// Track from the sequence's `initial_state` from frame 0.
+    Given,
+    /// Search for the hand: the free states' given values are not used (fixed ones are).
+    Auto,
+}
+
+impl Init {
+    /// The default for `sequence`: [`Init::Given`] when it has an initial state, else
+    /// [`Init::Auto`].
+    pub fn default_for(sequence: &Sequence) -> Init {
+        if sequence.initial_given {
+            Init::Given
+        } else {
+            Init::Auto
+        }
+    }
+}
+
+/// How a sequence is tracked besides the tracker's own parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackOptions {
+    /// How to start; `None`: [`Init::default_for`] the sequence.
+    pub init: Option<Init>,
+    /// What to do once the hand is lost for
+    /// [`LOST_FRAMES_BEFORE_SEARCH`](crate::acquire::LOST_FRAMES_BEFORE_SEARCH) frames.
+    pub recovery: Recovery,
+    /// The search's parameters.
+    pub acquire: AcquireConfig,
+}
+
+impl Default for TrackOptions {
+    fn default() -> Self {
+        TrackOptions {
+            init: None,
+            recovery: Recovery::Search,
+            acquire: AcquireConfig::default(),
+        }
+    }
+}
 
 /// What a tracking run did.
 #[derive(Debug, Clone, PartialEq)]
@@ -26,10 +76,14 @@ pub struct TrackSummary {
     pub frames: usize,
     /// Cameras.
     pub cameras: usize,
-    /// Frames the tracker flagged `lost`.
+    /// Frames written `lost` (no hand claimed: searching or lost).
     pub lost_frames: usize,
-    /// Mean over frames of the tracker's RMS image residual (px).
+    /// Mean over the frames not searching of the tracker's RMS image residual (px).
     pub mean_rms_px: f64,
+    /// How the run started.
+    pub init: Init,
+    /// Frames per status and the frames where it changed.
+    pub status: StatusCounts,
     /// Time spent in the tracker itself (s), without reading frames.
     pub tracking_seconds: f64,
     /// Wall time of the whole run, reading and writing included (s).
@@ -56,6 +110,11 @@ impl fmt::Display for TrackSummary {
             "tracked {} frames x {} camera(s): {} lost, mean rms {:.3} px",
             self.frames, self.cameras, self.lost_frames, self.mean_rms_px
         )?;
+        let init = match self.init {
+            Init::Given => "from the given initial state",
+            Init::Auto => "searching from frame 0",
+        };
+        writeln!(f, "{} ({init})", self.status)?;
         write!(
             f,
             "tracker time {:.3} s ({:.1} frames/s), total {:.3} s",
@@ -124,17 +183,76 @@ pub fn track_sequence_with(
     progress: bool,
     overlay_dir: Option<&Path>,
 ) -> Result<TrackSummary> {
+    track_sequence_opts(
+        seq,
+        out_csv,
+        config,
+        progress,
+        overlay_dir,
+        &TrackOptions::default(),
+    )
+}
+
+/// The status machine for `sequence` as `options` ask: tracking from the initial state
+/// ([`Init::Given`]) or searching from the search's base ([`Init::Auto`]). Fails, naming the
+/// sequence, when [`Init::Given`] is asked of a sequence without `initial_state`.
+pub fn sequence_auto_tracker(
+    sequence: &Sequence,
+    config: TrackerConfig,
+    options: &TrackOptions,
+) -> Result<AutoTracker> {
+    let init = options.init.unwrap_or(Init::default_for(sequence));
+    let to_f32 = |q: &[f64]| q.iter().map(|&v| v as f32).collect::<Vec<f32>>();
+    let name = sequence.dir.display();
+    let mut auto = match init {
+        Init::Given if !sequence.initial_given => bail!(
+            "{name}: --init given needs `initial_state` in sequence.json, which has none \
+             (use --init auto to let the tracker find the hand)"
+        ),
+        Init::Given => AutoTracker::tracking(
+            sequence.model.clone(),
+            &sequence.cameras,
+            &to_f32(&sequence.initial_state),
+            sequence.free_mask(),
+            config,
+            options.acquire,
+        ),
+        Init::Auto => AutoTracker::new(
+            sequence.model.clone(),
+            &sequence.cameras,
+            &to_f32(&sequence.search_base()),
+            sequence.free_mask(),
+            config,
+            options.acquire,
+        ),
+    }
+    .with_context(|| format!("{name}"))?;
+    auto.set_recovery(options.recovery);
+    Ok(auto)
+}
+
+/// [`track_sequence_with`] as `options` ask: how to start and whether to search again after
+/// a loss.
+pub fn track_sequence_opts(
+    seq: &Path,
+    out_csv: &Path,
+    config: TrackerConfig,
+    progress: bool,
+    overlay_dir: Option<&Path>,
+    options: &TrackOptions,
+) -> Result<TrackSummary> {
     let start = Instant::now();
     let sequence = Sequence::open(seq)?;
     sequence.check_frames()?;
     sequence.check_cameras_see_the_hand(&(0..sequence.cameras.len()).collect::<Vec<_>>())?;
-    let mut tracker = sequence_tracker(&sequence, config)
-        .map_err(|e| anyhow!("{}: cannot start the tracker: {e}", seq.display()))?;
-    let mut writer = StatesWriter::create(out_csv, sequence.n_states())?;
+    let init = options.init.unwrap_or(Init::default_for(&sequence));
+    let mut tracker = sequence_auto_tracker(&sequence, config, options)?;
+    let mut writer = StatesWriter::with_columns(out_csv, sequence.n_states(), &[STATUS_COLUMN])?;
     let mut overlays = overlay_dir.map(|_| PngWriter::start(8)).transpose()?;
     let bar = crate::progress::bar(sequence.frames, "track", progress);
     let mut tracking = Duration::ZERO;
-    let (mut lost, mut rms_sum) = (0, 0.0);
+    let (mut lost, mut rms_sum, mut rms_frames) = (0, 0.0, 0);
+    let mut statuses = Vec::with_capacity(sequence.frames);
     for k in 0..sequence.frames {
         let images = (0..sequence.cameras.len())
             .map(|c| sequence.read_frame(c, k))
@@ -148,21 +266,25 @@ pub fn track_sequence_with(
             })
             .collect::<Result<Vec<_>>>()?;
         let t0 = Instant::now();
-        let report = tracker.track(&views);
+        let report = tracker.step(&views);
         tracking += t0.elapsed();
-        let report = report.map_err(|e| {
+        let auto = report.map_err(|e| {
             let files: Vec<String> = (0..sequence.cameras.len())
                 .map(|c| sequence.frame_path(c, k).display().to_string())
                 .collect();
-            anyhow!("frame {k} ({}): the tracker failed: {e}", files.join(", "))
+            anyhow!(
+                "frame {k} ({}): the tracker failed: {e:#}",
+                files.join(", ")
+            )
         })?;
+        let report = auto.report;
         writer
-            .write(tracker.state(), &report)
+            .write_with(tracker.state(), &report, &[auto.status.as_str()])
             .with_context(|| format!("frame {k}"))?;
         if let (Some(dir), Some(writer)) = (overlay_dir, overlays.as_mut()) {
             for (c, image) in images.iter().enumerate() {
                 let drawn = draw_overlay(
-                    tracker.model(),
+                    tracker.tracker().model(),
                     &sequence.cameras[c],
                     tracker.state(),
                     image,
@@ -173,7 +295,11 @@ pub fn track_sequence_with(
             }
         }
         lost += usize::from(report.lost);
-        rms_sum += f64::from(report.rms_px);
+        if auto.status != Status::Searching {
+            rms_sum += f64::from(report.rms_px);
+            rms_frames += 1;
+        }
+        statuses.push(auto.status);
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -186,7 +312,9 @@ pub fn track_sequence_with(
         frames,
         cameras: sequence.cameras.len(),
         lost_frames: lost,
-        mean_rms_px: rms_sum / frames.max(1) as f64,
+        mean_rms_px: rms_sum / f64::from(rms_frames.max(1)),
+        init,
+        status: StatusCounts::of(&statuses),
         tracking_seconds: tracking.as_secs_f64(),
         total_seconds: start.elapsed().as_secs_f64(),
         out: out_csv.to_path_buf(),

@@ -84,7 +84,7 @@ fn render_track_and_evaluate_from_the_command_line() {
         .lines()
         .next()
         .unwrap()
-        .ends_with("q27,rms_px,iterations,features_found,features_expected,lost"));
+        .ends_with("q27,rms_px,iterations,features_found,features_expected,lost,status"));
     assert_eq!(states.lines().count(), 4);
     let out = digiteyes(&["eval", "seq", "states.csv"], dir.path());
     assert!(out.status.success(), "{}", text(&out.stderr));

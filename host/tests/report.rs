@@ -272,8 +272,10 @@ fn nan_states_are_gaps_and_dropped_frames_are_marked() {
             fields[9] = "nan".into();
         }
         if k == 5 {
-            let lost = fields.len() - 1;
+            // The last columns are `lost`, then `status`.
+            let lost = fields.len() - 2;
             fields[lost] = "1".into();
+            fields[lost + 1] = "lost".into();
         }
         fields.push(if k == 5 { "wrong size 64x48 <bad>" } else { "" }.into());
     });

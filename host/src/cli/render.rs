@@ -1,5 +1,6 @@
 //! `digiteyes render`: a synthetic scenario to a sequence folder.
 
+use std::ops::Range;
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -14,6 +15,9 @@ use crate::scenarios::{render_scenario, RenderOptions, DEFAULT_FRAMES, NAMES, RA
 /// Writes OUTDIR/sequence.json (model `builtin:hand`, cameras, initial state = truth at
 /// frame 0, free states), the frames OUTDIR/camN/NNNNNN.pgm and OUTDIR/truth.csv (every
 /// state at every frame). The motion is smooth and seeded; the hand stays in view.
+/// --no-initial-state leaves the initial state out (and every state free): the tracker
+/// must find the hand itself. --blackout A..B renders frames A to B-1 of every camera as
+/// the empty background (same noise and clutter) while the hand moves on.
 ///
 /// Scenarios:
 ///   mouse            3D-mouse sub-model (free q4 q5 q8 q9 q10 q19 q24): palm slides on the
@@ -67,6 +71,29 @@ pub struct RenderArgs {
     /// Rays per pixel along each axis (3 = 9 rays per pixel).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=8))]
     pub supersample: u32,
+    /// Leave initial_state out of sequence.json (every state then free, `free` left out).
+    #[arg(long)]
+    pub no_initial_state: bool,
+    /// Frames A..B (A included, B excluded, B <= --frames) rendered without the hand.
+    #[arg(long, value_name = "A..B", value_parser = frame_range)]
+    pub blackout: Option<Range<usize>>,
+}
+
+/// `A..B`: a non-empty range of frames (A included, B excluded).
+fn frame_range(text: &str) -> Result<Range<usize>, String> {
+    let bad = || {
+        format!(
+            "{} is not a range of frames: give A..B with A < B, e.g. 80..110",
+            crate::text::quote_value(text)
+        )
+    };
+    let (a, b) = text.trim().split_once("..").ok_or_else(bad)?;
+    let a: usize = a.trim().parse().map_err(|_| bad())?;
+    let b: usize = b.trim().parse().map_err(|_| bad())?;
+    if a >= b {
+        return Err(bad());
+    }
+    Ok(a..b)
 }
 
 /// Renders the scenario; `progress`: a progress bar on stderr.
@@ -80,6 +107,8 @@ pub fn run(args: RenderArgs, progress: bool) -> Result<()> {
         size: args.size,
         supersample: args.supersample,
         progress,
+        no_initial_state: args.no_initial_state,
+        blackout: args.blackout,
     };
     render_scenario(&args.scenario, &args.outdir, &opts)?;
     println!(

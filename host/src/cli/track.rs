@@ -3,18 +3,31 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use clap::Args;
+use clap::{Args, ValueEnum};
 
 use super::tracker_config;
-use crate::track::track_sequence_with;
+use crate::acquire::Recovery;
+use crate::track::{track_sequence_opts, Init, TrackOptions};
 
 /// Track a sequence and write the estimated states as CSV.
 ///
-/// Starts from the sequence's initial_state and estimates its free states from every
-/// frame of every camera. Output columns: frame, q0..q{n-1} (unit quaternion, mm, rad),
-/// rms_px, iterations, features_found, features_expected, lost (0/1). Prints a summary
-/// (frames, lost frames, mean RMS residual, frames/s). Exits non-zero, naming the file or
-/// frame, on bad input or a tracker error.
+/// Estimates the sequence's free states from every frame of every camera, inside a status
+/// machine: searching (no hand claimed) -> tracking -> lost -> searching. With --init
+/// given (the default when sequence.json has initial_state) it tracks from the initial
+/// state; with --init auto (the default when it has none) it searches for the hand
+/// itself, ignoring the free states' given values (fixed states keep theirs). A track
+/// lost for 10 frames in a row searches again (--recover search, the default): first
+/// locally around the last tracked state, then over the whole view. --recover never
+/// keeps the plain tracker's behaviour: a lost track is never searched for, and the
+/// output is the same as before the status machine existed (plus the status column).
+///
+/// Output columns: frame, q0..q{n-1} (unit quaternion, mm, rad), rms_px, iterations,
+/// features_found, features_expected, lost (0/1: 1 on every frame that claims no hand,
+/// searching or lost), status (searching, tracking or lost). While searching, the states
+/// are the last tracked ones (the search's base state before the first acquisition).
+/// Prints a summary (frames, lost frames, mean RMS residual, frames per status, the
+/// frames where the hand was acquired, lost and re-acquired, frames/s). Exits non-zero,
+/// naming the file or frame, on bad input or a tracker error.
 ///
 /// With --overlay DIR, each frame of each camera is also written as DIR/camN/NNNNNN.png,
 /// drawn at the state tracked for it, like the IC40's video overlay: the frame dimmed,
@@ -40,17 +53,55 @@ pub struct TrackArgs {
     /// Also draw every frame at its tracked state into DIR/camN/NNNNNN.png.
     #[arg(long, value_name = "DIR")]
     pub overlay: Option<PathBuf>,
+    /// How to start: `given` tracks from the sequence's initial_state, `auto` searches for
+    /// the hand (default: given when sequence.json has initial_state, else auto).
+    #[arg(long, value_enum, value_name = "HOW")]
+    pub init: Option<InitArg>,
+    /// After 10 lost frames in a row: `search` for the hand again (locally, then over the
+    /// view), or `never` (stay lost, as the plain tracker did).
+    #[arg(long, value_enum, value_name = "HOW", default_value = "search")]
+    pub recover: RecoverArg,
+}
+
+/// `--init`'s values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum InitArg {
+    /// Track from the sequence's initial_state.
+    Given,
+    /// Search for the hand.
+    Auto,
+}
+
+/// `--recover`'s values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RecoverArg {
+    /// Search again after a loss.
+    Search,
+    /// Never search: stay lost.
+    Never,
 }
 
 /// Tracks the sequence and prints the summary; `progress`: a progress bar on stderr.
 pub fn run(args: TrackArgs, progress: bool) -> Result<()> {
     let config = tracker_config(args.iterations, args.no_predict);
-    let summary = track_sequence_with(
+    let options = TrackOptions {
+        init: args.init.map(|i| match i {
+            InitArg::Given => Init::Given,
+            InitArg::Auto => Init::Auto,
+        }),
+        recovery: match args.recover {
+            RecoverArg::Search => Recovery::Search,
+            RecoverArg::Never => Recovery::Never,
+        },
+        ..TrackOptions::default()
+    };
+    let summary = track_sequence_opts(
         &args.seqdir,
         &args.out,
         config,
         progress && !args.quiet,
         args.overlay.as_deref(),
+        &options,
     )?;
     println!("{summary}");
     Ok(())

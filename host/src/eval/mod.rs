@@ -20,6 +20,7 @@ use digiteyes_core::nalgebra::Vector2;
 use digiteyes_core::quaternion;
 use serde::Serialize;
 
+use crate::sequence::status::{Status, StatusCounts};
 use crate::sequence::{read_states, Sequence};
 
 /// A frame's mean fingertip error above this (px) counts towards losing the track.
@@ -69,6 +70,15 @@ pub struct EvalReport {
     pub fingertip_mean_by_frame: Vec<f64>,
     /// Frames the tracker flagged `lost`, when the states file has that column.
     pub lost_frames: Option<usize>,
+    /// The first frame from which the hand is held: claimed (when the file says which frames
+    /// claim it) and the mean fingertip error below [`LOST_ERROR_PX`] for [`LOST_RUN`] frames;
+    /// `None` if never.
+    pub frames_to_acquire: Option<usize>,
+    /// The frames where the hand was held again (as for `frames_to_acquire`) after it had
+    /// been held and then not for [`LOST_RUN`] frames in a row.
+    pub reacquired_at: Vec<usize>,
+    /// Frames per status and where the status changed, when the file has a `status` column.
+    pub status: Option<StatusCounts>,
 }
 
 /// Compares the states in `states_csv` (the tracker's output, or any CSV starting with
@@ -100,6 +110,12 @@ pub fn evaluate(seq: &Path, states_csv: &Path) -> Result<EvalReport> {
     report.lost_frames = estimated
         .extra("lost")
         .map(|lost| lost.iter().filter(|&&v| v != 0.0).count());
+    report.set_acquisitions(&estimated.claimed());
+    report.status = estimated.status.as_ref().map(|column| {
+        // A frame with no status (a board's dropped frame) claims nothing: counted as lost.
+        let statuses: Vec<Status> = column.iter().map(|s| s.unwrap_or(Status::Lost)).collect();
+        StatusCounts::of(&statuses)
+    });
     Ok(report)
 }
 
@@ -185,9 +201,55 @@ pub fn compare(
         palm_translation_mm: stats::mean(&translation),
         palm_translation_max_mm: translation.iter().copied().fold(0.0, f64::max),
         track_life: track_life(&by_frame),
+        frames_to_acquire: acquisitions(&by_frame, &vec![true; truth.len()]).0,
+        reacquired_at: acquisitions(&by_frame, &vec![true; truth.len()]).1,
         fingertip_mean_by_frame: by_frame,
         lost_frames: None,
+        status: None,
     })
+}
+
+impl EvalReport {
+    /// Sets [`EvalReport::frames_to_acquire`] and [`EvalReport::reacquired_at`] from the
+    /// fingertip errors and which frames claim the hand (one flag per frame).
+    pub fn set_acquisitions(&mut self, claimed: &[bool]) {
+        let (first, again) = acquisitions(&self.fingertip_mean_by_frame, claimed);
+        self.frames_to_acquire = first;
+        self.reacquired_at = again;
+    }
+}
+
+/// The first frame from which the hand is held — claimed and the error (px) below
+/// [`LOST_ERROR_PX`] for [`LOST_RUN`] frames — and every frame it is held again after
+/// [`LOST_RUN`] frames in a row not held. A frame past the end of `claimed` counts as claimed.
+pub fn acquisitions(errors: &[f64], claimed: &[bool]) -> (Option<usize>, Vec<usize>) {
+    let good = |k: usize| claimed.get(k).copied().unwrap_or(true) && errors[k] < LOST_ERROR_PX;
+    let mut first = None;
+    let mut again = Vec::new();
+    let mut held = false;
+    let (mut good_run, mut bad_run) = (0, 0);
+    for k in 0..errors.len() {
+        if good(k) {
+            good_run += 1;
+            bad_run = 0;
+        } else {
+            bad_run += 1;
+            good_run = 0;
+        }
+        if !held && good_run == LOST_RUN {
+            let start = k + 1 - LOST_RUN;
+            if first.is_none() {
+                first = Some(start);
+            } else {
+                again.push(start);
+            }
+            held = true;
+        }
+        if held && bad_run == LOST_RUN {
+            held = false;
+        }
+    }
+    (first, again)
 }
 
 /// Fraction of frames before the first run of [`LOST_RUN`] frames whose error (px) all exceed
@@ -222,4 +284,30 @@ fn to_f32(q: &[f64]) -> Vec<f32> {
 
 fn unit(q: &[f32]) -> [f32; 4] {
     quaternion::normalised([q[0], q[1], q[2], q[3]]).unwrap_or([1.0, 0.0, 0.0, 0.0])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn acquisitions_need_five_good_claimed_frames() {
+        let e = |v: &[f64]| v.to_vec();
+        // Held from frame 2; a 5-frame loss; held again from frame 12.
+        let errors = e(&[
+            50., 50., 1., 1., 1., 1., 1., 50., 50., 50., 50., 50., 1., 1., 1., 1., 1.,
+        ]);
+        let all = vec![true; errors.len()];
+        assert_eq!(acquisitions(&errors, &all), (Some(2), vec![12]));
+        // Unclaimed frames are not held, whatever their error.
+        let errors = e(&[50., 50., 1., 1., 1., 1., 1., 1., 1.]);
+        let mut claimed = vec![true; errors.len()];
+        assert_eq!(acquisitions(&errors, &claimed).0, Some(2));
+        claimed[3] = false;
+        assert_eq!(acquisitions(&errors, &claimed).0, Some(4));
+        // A loss shorter than five frames is no re-acquisition.
+        let errors = e(&[1., 1., 1., 1., 1., 50., 50., 1., 1., 1., 1., 1.]);
+        assert_eq!(acquisitions(&errors, &[true; 12]), (Some(0), vec![]));
+        assert_eq!(acquisitions(&[50.; 8], &[true; 8]), (None, vec![]));
+    }
 }

@@ -48,6 +48,34 @@ impl fmt::Display for EvalReport {
         if let Some(lost) = self.lost_frames {
             writeln!(f, "frames flagged lost      {lost:8}")?;
         }
+        match self.frames_to_acquire {
+            Some(k) => writeln!(
+                f,
+                "frames to acquire        {k:8}       (first frame from which the hand is claimed with the fingertip error < {LOST_ERROR_PX} px for {LOST_RUN} frames)"
+            )?,
+            None => writeln!(
+                f,
+                "frames to acquire        never    (the hand is never claimed with the fingertip error < {LOST_ERROR_PX} px for {LOST_RUN} frames)"
+            )?,
+        }
+        let again = self
+            .reacquired_at
+            .iter()
+            .map(|k| k.to_string())
+            .collect::<Vec<_>>();
+        writeln!(
+            f,
+            "re-acquisitions          {:8}{}",
+            again.len(),
+            if again.is_empty() {
+                String::new()
+            } else {
+                format!("       (at frame {})", again.join(", "))
+            }
+        )?;
+        if let Some(status) = &self.status {
+            writeln!(f, "{status}")?;
+        }
         Ok(())
     }
 }

@@ -109,6 +109,16 @@ impl Renderer {
         Ok(filter::quantise(&img, w, h))
     }
 
+    /// The frame without the hand: the background, blurred and with noise drawn from
+    /// `noise_seed` exactly as [`Renderer::render`] draws it.
+    pub fn render_empty(&self, noise_seed: u64) -> GrayImage {
+        let (w, h) = self.size();
+        let mut img = self.background.clone();
+        filter::gaussian_blur(&mut img, w, h, self.settings.blur_sigma);
+        filter::add_noise(&mut img, self.settings.noise_sigma, noise_seed);
+        filter::quantise(&img, w, h)
+    }
+
     /// The fraction (0–1) of each pixel covered by the hand at states `q`, row-major.
     pub fn coverage(&self, q: &[f32]) -> Result<Vec<f32>> {
         let (w, h) = self.size();

@@ -50,6 +50,13 @@ pub fn accuracy(inputs: &Inputs, truth: &StateTable) -> Result<Option<Accuracy>>
     report.lost_frames = inputs
         .column("lost")
         .map(|_| inputs.lost.iter().filter(|&&l| l).count());
+    let claimed = inputs.estimate.table.claimed();
+    report.set_acquisitions(&kept.iter().map(|&k| claimed[k]).collect::<Vec<_>>());
+    // The comparison ran over the kept frames: back to frame numbers.
+    report.frames_to_acquire = report.frames_to_acquire.map(|i| kept[i]);
+    for k in &mut report.reacquired_at {
+        *k = kept[*k];
+    }
     let mut fingertip_px = vec![f64::NAN; estimated.len()];
     for (&k, &e) in kept.iter().zip(&report.fingertip_mean_by_frame) {
         fingertip_px[k] = e;

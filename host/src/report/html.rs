@@ -42,6 +42,7 @@ rect.lost{fill:#adb5bd;fill-opacity:.35}
 .key.estimate,.key.truth,.key.rms,.key.joint{stroke:none}
 .key.estimate{fill:#1f5fbf}.key.truth{fill:#d9480f}.key.rms{fill:#5c940d}.key.joint{fill:#862e9c}
 .key.lost{fill:#adb5bd}.key.dropped{fill:#c92a2a}.key.gap{fill:#f08c00}
+.status-searching{fill:#4dabf7}.status-tracking{fill:#40c057}.status-lost{fill:#f59f00}
 .thumbs{display:flex;flex-wrap:wrap;gap:10px}
 figure.thumb{margin:0;font-size:12px;color:#444}figure.thumb img{display:block;border:1px solid #ccc}
 figure.thumb.lost figcaption{color:#c92a2a}

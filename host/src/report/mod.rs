@@ -291,11 +291,31 @@ fn header(page: &mut Page, inputs: &Inputs, free: &[usize]) {
                 inputs.dropped.iter().flatten().count()
             ),
         ),
+        ("status", status_text(inputs)),
         (
             "made by",
             format!("digiteyes {}", env!("CARGO_PKG_VERSION")),
         ),
     ]);
+}
+
+/// The status row of the header: frames per status and where it changed, from the states'
+/// `status` column.
+fn status_text(inputs: &Inputs) -> String {
+    match &inputs.estimate.table.status {
+        Some(column) => {
+            let statuses: Vec<crate::sequence::status::Status> = column
+                .iter()
+                .map(|s| s.unwrap_or(crate::sequence::status::Status::Lost))
+                .collect();
+            let counts = crate::sequence::status::StatusCounts::of(&statuses).to_string();
+            counts
+                .strip_prefix("status: ")
+                .unwrap_or(&counts)
+                .to_string()
+        }
+        None => "no status column (a file from before the status machine)".to_string(),
+    }
 }
 
 /// The page's warnings: NaN states (naming the file and frames), an accuracy over fewer frames.
@@ -339,12 +359,15 @@ fn list_frames(frames: &[usize]) -> String {
 fn legend_note(inputs: &Inputs) -> &'static str {
     match inputs.truth {
         Some(_) => {
-            "Estimate (solid) and truth (dashed) in each state's unit; grey bands: frames \
-             flagged lost; red markers: frames the board dropped (hover for the reason); \
+            "Estimate (solid) and truth (dashed) in each state's unit; the strip along the top: \
+             the tracker's status (blue searching, green tracking, orange lost); grey bands: \
+             frames flagged lost (no hand claimed); red markers: frames the board dropped (hover for the reason); \
              orange: frames with no number."
         }
         None => {
-            "Estimate in each state's unit; grey bands: frames flagged lost; red markers: frames \
+            "Estimate in each state's unit; the strip along the top: the tracker's status (blue \
+             searching, green tracking, orange lost); grey bands: frames flagged lost (no hand \
+             claimed); red markers: frames \
              the board dropped (hover for the reason); orange: frames with no number."
         }
     }

@@ -6,6 +6,7 @@ use super::accuracy::Accuracy;
 use super::input::Inputs;
 use super::svg::{finite_range, Chart, LegendEntry};
 use crate::eval::LOST_ERROR_PX;
+use crate::sequence::status::Status;
 use crate::state_names::{state_label, state_unit};
 
 /// The plot of state `state` (model index) against time: `<svg class="state-plot"
@@ -132,11 +133,35 @@ pub(super) fn new_chart(inputs: &Inputs, y_range: (f64, f64)) -> Chart {
     Chart::new((first, last), y_range)
 }
 
-/// Shades the lost frames and marks the dropped frames and NaN gaps; returns the legend
-/// entries of what was drawn.
+/// Shades the lost frames, draws the status band (when the states file has a `status`
+/// column) and marks the dropped frames and NaN gaps; returns the legend entries of what was
+/// drawn.
 pub(super) fn decorate(chart: &mut Chart, inputs: &Inputs) -> Vec<LegendEntry> {
     let mut legend = Vec::new();
     let half = inputs.half_frame();
+    if let Some(column) = &inputs.estimate.table.status {
+        for status in Status::ALL {
+            let flags: Vec<bool> = column.iter().map(|s| *s == Some(status)).collect();
+            let runs = Inputs::runs(&flags);
+            let class = status_class(status);
+            for &(a, b) in &runs {
+                let title = if a == b {
+                    format!("frame {a} {status}")
+                } else {
+                    format!("frames {a}–{b} {status}")
+                };
+                chart.strip(
+                    inputs.times[a] - half,
+                    inputs.times[b] + half,
+                    class,
+                    &title,
+                );
+            }
+            if !runs.is_empty() {
+                legend.push(entry(class, status.as_str()));
+            }
+        }
+    }
     let runs = Inputs::runs(&inputs.lost);
     for &(a, b) in &runs {
         let title = if a == b {
@@ -175,6 +200,15 @@ pub(super) fn decorate(chart: &mut Chart, inputs: &Inputs) -> Vec<LegendEntry> {
         legend.push(entry("gap", "no number"));
     }
     legend
+}
+
+/// The class of a status's stretch of the status band (`status-searching`, ...).
+pub fn status_class(status: Status) -> &'static str {
+    match status {
+        Status::Searching => "status-searching",
+        Status::Tracking => "status-tracking",
+        Status::Lost => "status-lost",
+    }
 }
 
 pub(super) fn entry(class: &'static str, text: &str) -> LegendEntry {

@@ -12,6 +12,8 @@ use super::html::escape;
 pub const WIDTH: f64 = 440.0;
 /// Height of a chart's view box (SVG user units).
 pub const HEIGHT: f64 = 230.0;
+/// Height of the status band along the top of a plot (user units).
+pub const STRIP_HEIGHT: f64 = 5.0;
 /// Room left of the plot area for the y ticks and label.
 const LEFT: f64 = 62.0;
 /// Room right of the plot area.
@@ -160,6 +162,22 @@ impl Chart {
             top = self.y.p1,
             w = b - a,
             h = self.y.p0 - self.y.p1,
+            t = escape(title)
+        );
+    }
+
+    /// A strip from x `x0` to `x1` (data units, clipped to the plot) along the top of the plot
+    /// area, [`STRIP_HEIGHT`] high, with a tooltip: the status band.
+    pub fn strip(&mut self, x0: f64, x1: f64, class: &str, title: &str) {
+        let (a, b) = (self.clip_x(x0), self.clip_x(x1));
+        if b <= a {
+            return;
+        }
+        let _ = write!(
+            self.body,
+            r#"<rect class="{class}" x="{a:.2}" y="{top:.2}" width="{w:.2}" height="{STRIP_HEIGHT:.2}"><title>{t}</title></rect>"#,
+            top = self.y.p1,
+            w = b - a,
             t = escape(title)
         );
     }

@@ -15,6 +15,7 @@ pub mod mouse_thesis;
 pub mod random;
 pub mod trajectory;
 
+use std::ops::Range;
 use std::path::Path;
 
 use anyhow::{bail, ensure, Context, Result};
@@ -60,6 +61,13 @@ pub struct RenderOptions {
     pub supersample: u32,
     /// Show a progress bar on stderr (when it is a terminal).
     pub progress: bool,
+    /// Leave `initial_state` out of `sequence.json`; every state is then free (`free` left
+    /// out), as the format requires, and the tracker must find the hand itself.
+    pub no_initial_state: bool,
+    /// Frames (first included, last excluded) rendered as the empty background — the same
+    /// noise and clutter, no hand — while the hand moves on as before (`truth.csv` keeps its
+    /// true state).
+    pub blackout: Option<Range<usize>>,
 }
 
 impl Default for RenderOptions {
@@ -73,6 +81,8 @@ impl Default for RenderOptions {
             size: None,
             supersample: 3,
             progress: false,
+            no_initial_state: false,
+            blackout: None,
         }
     }
 }
@@ -171,8 +181,12 @@ pub fn generate_from(scenario: Scenario, opts: &RenderOptions) -> Result<Generat
         model: BUILTIN_HAND.to_string(),
         fps: Some(FPS),
         cameras: camera_files,
-        initial_state: truth[0].clone(),
-        free: Some(scenario.free.iter().map(|&s| s as i64).collect()),
+        initial_state: if opts.no_initial_state {
+            Vec::new()
+        } else {
+            truth[0].clone()
+        },
+        free: (!opts.no_initial_state).then(|| scenario.free.iter().map(|&s| s as i64).collect()),
     };
     let clutter = opts.clutter.unwrap_or(scenario.clutter);
     let settings = RenderSettings {
@@ -208,6 +222,15 @@ pub fn render_scenario(name: &str, out: &Path, opts: &RenderOptions) -> Result<(
 
 /// Writes a generated scenario into `out`.
 pub fn write_generated(generated: &Generated, out: &Path, opts: &RenderOptions) -> Result<()> {
+    if let Some(b) = &opts.blackout {
+        ensure!(
+            b.start < b.end && b.end <= generated.truth.len(),
+            "blackout {}..{}: give frames A..B with A < B <= {} (the sequence's frames)",
+            b.start,
+            b.end,
+            generated.truth.len()
+        );
+    }
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     sequence::write_sequence_json(out, &generated.file)?;
     sequence::write_truth(&out.join(sequence::TRUTH_CSV), &generated.truth)?;
@@ -233,10 +256,16 @@ pub fn write_generated(generated: &Generated, out: &Path, opts: &RenderOptions) 
     );
     for (k, q) in generated.truth.iter().enumerate() {
         let q: Vec<f32> = q.iter().map(|&v| v as f32).collect();
+        let dark = opts.blackout.as_ref().is_some_and(|b| b.contains(&k));
         for (c, renderer) in renderers.iter().enumerate() {
-            let image = renderer
-                .render(&q, mix(opts.seed, c as u64, k as u64))
-                .with_context(|| format!("frame {k}, camera {c}"))?;
+            let seed = mix(opts.seed, c as u64, k as u64);
+            let image = if dark {
+                renderer.render_empty(seed)
+            } else {
+                renderer
+                    .render(&q, seed)
+                    .with_context(|| format!("frame {k}, camera {c}"))?
+            };
             sequence::write_frame(out, c, k, &image)?;
         }
         bar.inc(1);

@@ -21,7 +21,8 @@ pub struct SequenceFile {
     /// The cameras; camera `i`'s frames are in folder `cam{i}`.
     pub cameras: Vec<CameraFile>,
     /// The state at frame 0: quaternion `w, x, y, z`, translation (mm), joint angles (rad).
-    /// Optional in the format (empty when absent); the tracker needs it today.
+    /// Optional (empty when absent): without it every state must be free, and the tracker
+    /// finds the hand itself.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub initial_state: Vec<f64>,
     /// The states the tracker estimates; absent means all.

@@ -12,6 +12,7 @@
 pub mod json;
 pub mod pgm;
 pub mod states;
+pub mod status;
 
 use std::path::{Path, PathBuf};
 
@@ -42,8 +43,12 @@ pub struct Sequence {
     pub model: Model,
     /// The cameras, validated; camera `i`'s frames are in `cam{i}/`.
     pub cameras: Vec<Camera>,
-    /// The state at frame 0 (quaternion, mm, rad), one value per model state.
+    /// The state at frame 0 (quaternion, mm, rad), one value per model state. When
+    /// `sequence.json` gives none ([`Sequence::initial_given`] false), the search's base
+    /// state ([`base_state`]): the tracker must then find the hand itself.
     pub initial_state: Vec<f64>,
+    /// Whether `sequence.json` gives `initial_state`.
+    pub initial_given: bool,
     /// The free states, sorted; `None` when `sequence.json` has no `free` (all are free).
     pub free: Option<Vec<u8>>,
     /// Frames per camera.
@@ -73,20 +78,37 @@ impl Sequence {
         let at = |what: String| format!("{}: {what}", json_path.display());
         let model = load_model(dir, &file.model).with_context(|| at("model".into()))?;
         let cameras = check_cameras(&file.cameras).with_context(|| at("cameras".into()))?;
-        let initial_state = check_initial_state(&file.initial_state, &model)
-            .with_context(|| at("initial_state".into()))?;
+        let initial_given = !file.initial_state.is_empty();
+        let initial_state = if initial_given {
+            check_initial_state(&file.initial_state, &model)
+                .with_context(|| at("initial_state".into()))?
+        } else {
+            base_state(&model, &cameras)
+        };
         let free = match &file.free {
             Some(list) => {
                 Some(check_free(list, model.n_states()).with_context(|| at("free".into()))?)
             }
             None => None,
         };
+        if let (false, Some(list)) = (initial_given, &free) {
+            ensure!(
+                list.len() == model.n_states(),
+                "{}: `initial_state` is absent, so every state must be free, but `free` lists \
+                 {} of the model's {} states (leave `free` out, list every state, or give \
+                 `initial_state`)",
+                json_path.display(),
+                list.len(),
+                model.n_states()
+            );
+        }
         Ok(Sequence {
             dir: dir.to_path_buf(),
             file,
             model,
             cameras,
             initial_state,
+            initial_given,
             free,
             frames: 0,
         })
@@ -114,6 +136,24 @@ impl Sequence {
                 .fold(FreeMask(0), |m, &s| FreeMask(m.0 | 1 << s)),
             None => FreeMask::all(self.n_states()),
         }
+    }
+
+    /// The state a search starts from for `track --init auto`: the fixed states at their
+    /// `initial_state` values, the free ones at the [`base_state`]'s (what a free state's
+    /// given value was is not used).
+    pub fn search_base(&self) -> Vec<f64> {
+        let base = base_state(&self.model, &self.cameras);
+        let free = self.free_mask();
+        (0..self.n_states())
+            .map(|s| {
+                let quaternion_free = s < 4 && free.contains(0);
+                if free.contains(s) || quaternion_free {
+                    base[s]
+                } else {
+                    self.initial_state[s]
+                }
+            })
+            .collect()
     }
 
     /// The name of camera `cam` for reports: its `name`, or `cam{cam}`.
@@ -169,10 +209,17 @@ impl Sequence {
     /// Refuses a camera that cannot see the hand at its initial state: every link behind it
     /// or projected outside its frame (a hand placed behind the camera, absurd intrinsics such
     /// as fx = 1e30). Tracking such a camera could only report every frame lost.
+    /// Without `initial_state`, the hand is looked for at the base state (the working volume's
+    /// centre).
     pub fn check_cameras_see_the_hand(&self, cameras: &[usize]) -> Result<()> {
         let q: Vec<f32> = self.initial_state.iter().map(|&v| v as f32).collect();
         let poses = Poses::compute(&self.model, &q)
             .map_err(|e| anyhow::anyhow!("{}: initial_state: {e}", self.json_path().display()))?;
+        let at = if self.initial_given {
+            "initial_state"
+        } else {
+            "the working volume's centre (no initial_state)"
+        };
         for &c in cameras {
             let camera = &self.cameras[c];
             let (w, h) = (camera.width as f32, camera.height as f32);
@@ -196,7 +243,7 @@ impl Sequence {
                     "no joint of the hand projects into its frame"
                 };
                 bail!(
-                    "{}: camera {c} ({}) cannot see the hand at initial_state: {why} \
+                    "{}: camera {c} ({}) cannot see the hand at {at}: {why} \
                      (check its R, t and fx, fy, cx, cy)",
                     self.json_path().display(),
                     self.camera_name(c)
@@ -313,14 +360,35 @@ pub fn check_cameras(cameras: &[CameraFile]) -> Result<Vec<Camera>> {
         .collect()
 }
 
-fn check_initial_state(state: &[f64], model: &Model) -> Result<Vec<f64>> {
-    ensure!(
-        !state.is_empty(),
-        "missing: the format allows leaving out the starting state, but digiteyes does not \
-         find the hand by itself yet; give the state at frame 0 ({} numbers: quaternion \
-         w x y z, translation in mm, joint angles in rad)",
-        model.n_states()
+/// The state a search starts from when nothing is known of the hand: the palm unrotated at
+/// the centre of the rig's default working volume
+/// ([`WorkingVolume::from_cameras`](digiteyes_core::acquire::WorkingVolume::from_cameras)),
+/// every joint at 0 rad (or the nearest end of its range).
+pub fn base_state(model: &Model, cameras: &[Camera]) -> Vec<f64> {
+    let volume = digiteyes_core::acquire::WorkingVolume::from_cameras(
+        cameras,
+        digiteyes_core::auto_tracker::FALLBACK_DEPTH_MM,
     );
+    let mut q = vec![0.0; model.n_states()];
+    if let Some(w) = q.first_mut() {
+        *w = 1.0;
+    }
+    for (d, c) in q.iter_mut().skip(4).take(3).zip(volume.centre_mm) {
+        *d = f64::from(c);
+    }
+    for (s, v) in q
+        .iter_mut()
+        .enumerate()
+        .skip(digiteyes_core::model::BASE_STATES)
+    {
+        if let Some(l) = model.limit(s) {
+            *v = f64::from(0.0f32.clamp(l.lo, l.hi));
+        }
+    }
+    q
+}
+
+fn check_initial_state(state: &[f64], model: &Model) -> Result<Vec<f64>> {
     ensure!(
         state.len() == model.n_states(),
         "{} values, the model has {} states",

@@ -11,6 +11,8 @@ use anyhow::{bail, Context, Result};
 use digiteyes_core::state::renormalise_quaternion;
 use digiteyes_core::tracker::FrameReport;
 
+use super::status::{Status, STATUS_COLUMN};
+
 /// The report columns the tracker's output adds after the states.
 pub const REPORT_COLUMNS: [&str; 5] = [
     "rms_px",
@@ -29,6 +31,10 @@ pub struct StateTable {
     pub extra_columns: Vec<String>,
     /// Values of those columns, one vector per frame (`NaN` where not a number).
     pub extras: Vec<Vec<f64>>,
+    /// The `status` column, one per frame, when the file has it (files written before the
+    /// column existed have none); `None` for a frame whose field is empty (e.g. a frame a
+    /// board dropped).
+    pub status: Option<Vec<Option<Status>>>,
 }
 
 impl StateTable {
@@ -36,6 +42,21 @@ impl StateTable {
     pub fn extra(&self, name: &str) -> Option<Vec<f64>> {
         let i = self.extra_columns.iter().position(|c| c == name)?;
         Some(self.extras.iter().map(|row| row[i]).collect())
+    }
+
+    /// Per frame, whether it claims a hand: from the `status` column when there is one
+    /// (tracking), else from `lost` (0), else every frame.
+    pub fn claimed(&self) -> Vec<bool> {
+        if let Some(status) = &self.status {
+            return status
+                .iter()
+                .map(|s| s.is_some_and(Status::claims_hand))
+                .collect();
+        }
+        match self.extra("lost") {
+            Some(lost) => lost.iter().map(|&v| v == 0.0).collect(),
+            None => vec![true; self.rows.len()],
+        }
     }
 }
 
@@ -126,10 +147,15 @@ fn parse_table(text: &str, n_states: usize, gaps: bool) -> Result<StatesWithGaps
         .iter()
         .map(|c| c.to_string())
         .collect();
+    let status_at = extra_columns
+        .iter()
+        .position(|c| c == STATUS_COLUMN)
+        .map(|i| i + n_states + 1);
     let mut table = StateTable {
         rows: Vec::new(),
         extra_columns,
         extras: Vec::new(),
+        status: status_at.map(|_| Vec::new()),
     };
     let mut extra_text = Vec::new();
     for (index, line) in lines {
@@ -171,6 +197,18 @@ fn parse_table(text: &str, n_states: usize, gaps: bool) -> Result<StatesWithGaps
             .iter()
             .map(|f| f.parse::<f64>().unwrap_or(f64::NAN))
             .collect();
+        if let (Some(i), Some(column)) = (status_at, table.status.as_mut()) {
+            let word = fields[i];
+            let status = Status::from_word(word);
+            if status.is_none() && !word.is_empty() {
+                bail!(
+                    "line {number}: status {} is not one of searching, tracking, lost \
+                     (or empty)",
+                    crate::text::quote_value(word)
+                );
+            }
+            column.push(status);
+        }
         table.rows.push(state);
         table.extras.push(extras);
         extra_text.push(
@@ -366,6 +404,32 @@ mod tests {
         assert!(err("frame,q0,q1\n1,1,2\n").contains("expected frame 0"));
         assert!(err("frame,q0,q1\n0,1,x\n").contains("q1"));
         assert!(err("frame,q0,q1\n0,1,2\n1,1,nan\n").contains("line 3"));
+    }
+
+    #[test]
+    fn the_status_column_is_read_when_present_and_checked() {
+        let with =
+            "frame,q0,q1,lost,status\n0,1,2,1,searching\n1,1,2,0,tracking\n2,1,2,1,lost\n3,1,2,1,\n";
+        let table = parse_states(with, 2).unwrap();
+        assert_eq!(
+            table.status,
+            Some(vec![
+                Some(Status::Searching),
+                Some(Status::Tracking),
+                Some(Status::Lost),
+                None
+            ])
+        );
+        assert_eq!(table.claimed(), vec![false, true, false, false]);
+        let without = "frame,q0,q1,lost\n0,1,2,1\n1,1,2,0\n";
+        let table = parse_states(without, 2).unwrap();
+        assert_eq!(table.status, None);
+        assert_eq!(table.claimed(), vec![false, true]);
+        let err = format!(
+            "{:#}",
+            parse_states("frame,q0,q1,status\n0,1,2,Tracking\n", 2).unwrap_err()
+        );
+        assert!(err.contains("line 2") && err.contains("Tracking"), "{err}");
     }
 
     #[test]

@@ -1,0 +1,234 @@
+//! Losing the hand and finding it again: a blackout (frames rendered as the empty background
+//! while the hand moves on) must turn the status to `lost`, then `searching`, and the local
+//! re-acquisition must find the hand again soon after it returns; frames without the hand are
+//! never claimed; and while the hand is not lost, the status machine tracks exactly as the
+//! plain tracker does. Sequences are short and small (320×240): quick in debug builds too.
+
+use std::path::{Path, PathBuf};
+
+use digiteyes_core::frame::FrameView;
+use digiteyes_host::acquire::{AutoTracker, Recovery, Status, LOST_FRAMES_BEFORE_SEARCH};
+use digiteyes_host::sequence::{read_states, Sequence};
+use digiteyes_host::track::{sequence_auto_tracker, track_sequence_opts, TrackOptions};
+use digiteyes_host::{render_scenario, sequence_tracker, RenderOptions, TrackerConfig};
+
+/// `fullhand-stereo` at 320×240, `frames` frames, frames `dark` without the hand.
+fn render(dir: &Path, frames: usize, dark: std::ops::Range<usize>) -> PathBuf {
+    let seq = dir.join("stereo");
+    let options = RenderOptions {
+        frames: Some(frames),
+        size: Some((320, 240)),
+        supersample: 2,
+        blackout: Some(dark),
+        ..RenderOptions::default()
+    };
+    render_scenario("fullhand-stereo", &seq, &options).unwrap();
+    seq
+}
+
+fn views(images: &[image::GrayImage]) -> Vec<FrameView<'_>> {
+    images
+        .iter()
+        .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize).unwrap())
+        .collect()
+}
+
+fn frames(sequence: &Sequence, k: usize) -> Vec<image::GrayImage> {
+    (0..sequence.cameras.len())
+        .map(|c| sequence.read_frame(c, k).unwrap())
+        .collect()
+}
+
+fn palm_error_mm(truth: &[f64], q: &[f64]) -> f64 {
+    (4..7)
+        .map(|i| (truth[i] - q[i]).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+#[test]
+fn after_a_blackout_the_hand_is_lost_searched_and_found_again_within_30_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b, n) = (20, 50, 80);
+    let seq = render(dir.path(), n, a..b);
+    let out = dir.path().join("states.csv");
+    let summary = track_sequence_opts(
+        &seq,
+        &out,
+        TrackerConfig::default(),
+        false,
+        None,
+        &TrackOptions::default(),
+    )
+    .unwrap();
+    println!("{summary}");
+    let sequence = Sequence::open(&seq).unwrap();
+    let table = read_states(&out, sequence.n_states()).unwrap();
+    let truth = sequence.read_truth().unwrap();
+    let status: Vec<Status> = table
+        .status
+        .unwrap()
+        .into_iter()
+        .map(Option::unwrap)
+        .collect();
+    let word = |s: &[Status]| s.iter().map(|s| &s.as_str()[..1]).collect::<String>();
+    println!("{}", word(&status));
+    // Tracked up to the blackout, then lost, then searching, never claimed in the dark.
+    assert!(
+        status[..a].iter().all(|&s| s == Status::Tracking),
+        "{}",
+        word(&status)
+    );
+    assert_eq!(status[a], Status::Lost, "the first dark frame is lost");
+    let searching = a + LOST_FRAMES_BEFORE_SEARCH as usize - 1;
+    assert!(status[a..searching].iter().all(|&s| s == Status::Lost));
+    assert!(status[searching..b].iter().all(|&s| s == Status::Searching));
+    // Found again within 30 frames of the hand's return, and held to the end near the truth.
+    let back = (b..n)
+        .find(|&k| status[k] == Status::Tracking)
+        .expect("never re-acquired");
+    assert!(
+        back < b + 30,
+        "re-acquired at frame {back}, {} after its return",
+        back - b
+    );
+    assert_eq!(summary.status.reacquired, vec![back]);
+    assert_eq!(summary.status.lost_at, vec![a]);
+    let after = status.iter().zip(&truth.rows).zip(&table.rows).enumerate();
+    for (k, ((s, t), q)) in after.skip(back + 5) {
+        assert_eq!(*s, Status::Tracking, "frame {k}");
+        let e = palm_error_mm(t, q);
+        assert!(e < 10.0, "frame {k}: palm {e:.1} mm from the truth");
+    }
+    // While searching, the states hold the last tracked one.
+    for (k, row) in table.rows.iter().enumerate().take(back).skip(searching) {
+        assert_eq!(row, &table.rows[a - 1], "frame {k}");
+    }
+    // eval sees the acquisition at frame 0 and the re-acquisition; the report draws the band.
+    let report = digiteyes_host::evaluate(&seq, &out).unwrap();
+    println!("{report}");
+    assert_eq!(report.frames_to_acquire, Some(0));
+    assert_eq!(report.reacquired_at.len(), 1, "{:?}", report.reacquired_at);
+    assert!(report.reacquired_at[0] >= back && report.reacquired_at[0] < b + 30);
+    assert_eq!(report.status.unwrap().reacquired, vec![back]);
+    let mut options = digiteyes_host::report::ReportOptions::default();
+    options.thumb_every = 0;
+    let (html, _) = digiteyes_host::report::build_report(&seq, &out, &options).unwrap();
+    for class in ["status-searching", "status-tracking", "status-lost"] {
+        assert!(
+            html.contains(&format!(r#"<rect class="{class}""#)),
+            "no {class} band"
+        );
+    }
+}
+
+#[test]
+fn frames_without_the_hand_are_never_claimed() {
+    // A blackout longer than the local re-acquisition: the local and then the global search
+    // both run on hand-free frames (plain background, noise σ 2 as rendered).
+    let dir = tempfile::tempdir().unwrap();
+    let (a, n) = (3, 3 + 10 + 70);
+    let seq = render(dir.path(), n, a..n);
+    let sequence = Sequence::open(&seq).unwrap();
+    let mut auto = sequence_auto_tracker(
+        &sequence,
+        TrackerConfig::default(),
+        &TrackOptions::default(),
+    )
+    .unwrap();
+    let (mut local, mut global, mut refused) = (0, 0, 0);
+    for k in 0..n {
+        let images = frames(&sequence, k);
+        let r = auto.step(&views(&images)).unwrap();
+        if k >= a {
+            assert_ne!(
+                r.status,
+                Status::Tracking,
+                "hand-free frame {k} claimed a hand"
+            );
+            assert!(r.report.lost, "frame {k}");
+        }
+        local += usize::from(r.local);
+        global += usize::from(r.status == Status::Searching && !r.local);
+        refused += usize::from(r.leaf_score.is_some());
+    }
+    println!("{local} local frames, {global} global, {refused} hypotheses refused");
+    assert!(
+        local >= 50,
+        "the local re-acquisition must have run: {local}"
+    );
+    assert!(global >= 5, "the global search must have run: {global}");
+}
+
+#[test]
+fn the_status_machine_tracks_bit_for_bit_as_the_tracker_while_not_lost() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("mouse");
+    let options = RenderOptions {
+        frames: Some(12),
+        size: Some((320, 240)),
+        supersample: 1,
+        ..RenderOptions::default()
+    };
+    render_scenario("mouse", &seq, &options).unwrap();
+    let sequence = Sequence::open(&seq).unwrap();
+    let config = TrackerConfig::default();
+    let mut plain = sequence_tracker(&sequence, config).unwrap();
+    let initial: Vec<f32> = sequence.initial_state.iter().map(|&v| v as f32).collect();
+    let mut auto = AutoTracker::tracking(
+        sequence.model.clone(),
+        &sequence.cameras,
+        &initial,
+        sequence.free_mask(),
+        config,
+        Default::default(),
+    )
+    .unwrap();
+    for k in 0..sequence.frames {
+        let images = frames(&sequence, k);
+        let expected = plain.track(&views(&images)).unwrap();
+        let got = auto.step(&views(&images)).unwrap();
+        assert!(
+            !expected.lost,
+            "frame {k}: the test needs a sequence never lost"
+        );
+        assert_eq!(got.report, expected, "frame {k}");
+        assert_eq!(got.status, Status::Tracking);
+        let bits = |q: &[f32]| q.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(auto.state()), bits(plain.state()), "frame {k}");
+    }
+}
+
+#[test]
+fn recover_never_writes_the_plain_trackers_states_through_a_blackout() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b, n) = (4, 20, 26);
+    let seq = render(dir.path(), n, a..b);
+    let sequence = Sequence::open(&seq).unwrap();
+    let mut plain = sequence_tracker(&sequence, TrackerConfig::default()).unwrap();
+    let options = TrackOptions {
+        recovery: Recovery::Never,
+        ..TrackOptions::default()
+    };
+    let mut auto = sequence_auto_tracker(&sequence, TrackerConfig::default(), &options).unwrap();
+    let (mut lost_run, mut longest) = (0, 0);
+    for k in 0..n {
+        let images = frames(&sequence, k);
+        let expected = plain.track(&views(&images)).unwrap();
+        let got = auto.step(&views(&images)).unwrap();
+        assert_eq!(got.report, expected, "frame {k}");
+        assert_eq!(auto.state(), plain.state(), "frame {k}");
+        assert_ne!(
+            got.status,
+            Status::Searching,
+            "frame {k}: --recover never searched"
+        );
+        lost_run = if expected.lost { lost_run + 1 } else { 0 };
+        longest = longest.max(lost_run);
+        assert_eq!(got.status == Status::Lost, expected.lost, "frame {k}");
+    }
+    assert!(
+        longest >= LOST_FRAMES_BEFORE_SEARCH as usize,
+        "the blackout must lose the hand long enough to search: {longest} frames"
+    );
+}
