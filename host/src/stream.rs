@@ -31,7 +31,7 @@ use crate::sequence::{Sequence, StatesWriter};
 pub const DROPPED_COLUMN: &str = "dropped";
 
 /// The column after it: the board's status for the frame (`Status::as_str`'s words).
-pub const STATUS_COLUMN: &str = "status";
+pub use crate::sequence::status::STATUS_COLUMN;
 
 /// The default line speed (bits/s).
 pub const DEFAULT_BAUD: u32 = 115_200;
@@ -51,8 +51,9 @@ pub struct StreamOptions {
     /// The tracker parameters sent in `Configure`.
     pub tracker: TrackerParams,
     /// How the board starts (`Reset`): from the sequence's initial state, or searching for
-    /// the free states (`--init auto`).
-    pub start: Start,
+    /// the free states (`--init auto`); `None`: given when the sequence has an initial state,
+    /// searching when it has none.
+    pub start: Option<Start>,
     /// The board's search budget per frame, in evaluations (`Configure`).
     pub search_evaluations_per_frame: u16,
     /// Show a progress bar (when stderr is a terminal).
@@ -68,14 +69,15 @@ impl StreamOptions {
             reply_timeout: DEFAULT_REPLY_TIMEOUT,
             camera_index: None,
             tracker: TrackerParams::default(),
-            start: Start::Given,
+            start: None,
             search_evaluations_per_frame: default_search_evaluations(),
             progress: false,
         }
     }
 
-    /// Starting the board this way.
-    pub fn start(mut self, start: Start) -> Self {
+    /// Starting the board this way (`None`: as the sequence allows, see
+    /// [`SessionSetup::from_sequence`]).
+    pub fn start(mut self, start: Option<Start>) -> Self {
         self.start = start;
         self
     }
@@ -333,7 +335,16 @@ fn pick_camera(sequence: &Sequence, index: Option<usize>) -> Result<usize> {
 fn connect(sequence: &Sequence, options: &StreamOptions) -> Result<Session> {
     let mut setup = SessionSetup::from_sequence(sequence, options.camera_index)?;
     setup.tracker = options.tracker;
-    setup.start = options.start;
+    if let Some(start) = options.start {
+        if start == Start::Given && !sequence.initial_given {
+            anyhow::bail!(
+                "{}: --init given needs `initial_state` in sequence.json, which has none \
+                 (leave --init out, or use --init auto)",
+                sequence.dir.display()
+            );
+        }
+        setup.start = start;
+    }
     setup.search_evaluations_per_frame = options.search_evaluations_per_frame;
     setup.reply_timeout = options.reply_timeout;
     let link = Link::open(&options.port, options.baud)?;

@@ -70,9 +70,10 @@ pub struct StreamArgs {
     pub iterations: Option<u8>,
     /// How the board starts: `given` tracks from sequence.json's initial_state; `auto`
     /// searches for the hand (the free states' initial values are ignored, the fixed ones
-    /// kept). One board per camera (the host's own tracker) supports `given` only.
-    #[arg(long, value_enum, default_value_t = InitArg::Given)]
-    pub init: InitArg,
+    /// kept). Default: `given` when sequence.json has an initial_state, `auto` when it has
+    /// none. One board per camera (the host's own tracker) supports `given` only.
+    #[arg(long, value_enum)]
+    pub init: Option<InitArg>,
     /// The board's search budget: evaluations per frame at most while it searches, 1 to
     /// 65535 (default: the search's, 1000). Lower keeps a searching frame's time nearer a
     /// tracking frame's; the search then takes more frames.
@@ -137,7 +138,7 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
                 port.port.len()
             );
         };
-        if args.init == InitArg::Auto {
+        if args.init == Some(InitArg::Auto) {
             bail!(
                 "--init auto: with one board per camera the host tracks, from the sequence's \
                  initial_state only (accepted: --init given); a single board searches itself"
@@ -163,7 +164,7 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
         .baud(port.baud)
         .reply_timeout(cli_values::duration(port.reply_timeout))
         .camera_index(args.camera_index)
-        .start(args.init.into())
+        .start(args.init.map(Start::from))
         .progress(progress && !args.quiet);
     options.tracker = tracker;
     if let Some(n) = args.search_evaluations {

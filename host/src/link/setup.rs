@@ -81,7 +81,12 @@ impl SessionSetup {
             stats_every: 0,
             initial_state: sequence.initial_state.iter().map(|&v| v as f32).collect(),
             free,
-            start: Start::Given,
+            // A sequence without an initial state can only be searched for.
+            start: if sequence.initial_given {
+                Start::Given
+            } else {
+                Start::Search
+            },
             search_evaluations_per_frame: default_search_evaluations(),
             model_digest: model_digest(&sequence.model),
             model_name: sequence.file.model.clone(),
