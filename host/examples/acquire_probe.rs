@@ -69,6 +69,11 @@ struct Args {
     #[arg(long)]
     rounds: Option<u8>,
     #[arg(long)]
+    refine_seeds: Option<u8>,
+    /// The coarse level's points per line and silhouette grid, e.g. 3,10.
+    #[arg(long, value_delimiter = ',')]
+    coarse_sampling: Option<Vec<u8>>,
+    #[arg(long)]
     leaves_per_frame: Option<u8>,
     #[arg(long)]
     leaves: Option<u8>,
@@ -85,6 +90,10 @@ struct Args {
     /// search with acceptance off, and write their leaves' judgements to the CSV.
     #[arg(long, default_value_t = 0)]
     hand_free: usize,
+    /// Also start the tracker at the truth of frame 10 and report whether it holds the hand
+    /// (within the limit) for the next 5 frames: the most any search could give.
+    #[arg(long)]
+    oracle: bool,
     /// Print each run's frame-by-frame statuses.
     #[arg(long)]
     verbose: bool,
@@ -104,6 +113,11 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         coarse_poses: args.coarse_poses.unwrap_or(d.coarse_poses),
         tree_levels: args.tree_levels.unwrap_or(d.tree_levels),
         refine_rounds: args.rounds.unwrap_or(d.refine_rounds),
+        refine_seeds: args.refine_seeds.unwrap_or(d.refine_seeds),
+        coarse_sampling: match args.coarse_sampling.as_deref() {
+            Some([a, b]) => [*a, *b],
+            _ => d.coarse_sampling,
+        },
         ..d
     };
     let f = FinderConfig::default();
@@ -314,6 +328,37 @@ fn run(
     Ok(out)
 }
 
+/// Whether the tracker started at the truth of frame `start` holds the hand within `limit`
+/// for [`HELD_FRAMES`] frames (the first tracked on `start` itself).
+fn oracle_holds(sequence: &Sequence, start: usize, limit: f32) -> Result<bool> {
+    let truth = sequence.read_truth()?;
+    let q: Vec<f32> = truth.rows[start].iter().map(|&v| v as f32).collect();
+    let mut tracker = Tracker::new(
+        sequence.model.clone(),
+        &sequence.cameras,
+        &q,
+        sequence.free_mask(),
+        TrackerConfig::default(),
+    )
+    .map_err(|e| anyhow!("{e}"))?;
+    for k in start..start + HELD_FRAMES {
+        let images: Vec<_> = (0..sequence.cameras.len())
+            .map(|c| sequence.read_frame(c, k))
+            .collect::<Result<_>>()?;
+        let views: Vec<_> = images
+            .iter()
+            .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
+            .collect::<Result<_, _>>()?;
+        let report = tracker.track(&views).map_err(|e| anyhow!("{e}"))?;
+        let t: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
+        let e = tip_error_px(&sequence.model, &sequence.cameras, tracker.state(), &t);
+        if report.lost || e > limit {
+            return Ok(false);
+        }
+    }
+    Ok(true)
+}
+
 /// A hand-free frame: a grey background, optional noise, optional clutter (bright and dark
 /// bars at every angle), from a small deterministic generator (as tests/tests/acquire.rs).
 fn hand_free(w: usize, h: usize, grey: u8, noise: u8, clutter: bool, seed: u64) -> Vec<u8> {
@@ -452,6 +497,10 @@ fn main() -> Result<()> {
             render_scenario(&name, &seq, &options)?;
             let sequence = Sequence::open(&seq)?;
             let r = run(&sequence, &args, &format!("{rig}-{seed}"), &mut csv)?;
+            if args.oracle {
+                let held = oracle_holds(&sequence, 10, 10.0 * args.width as f32 / 640.0)?;
+                eprintln!("{rig}-{seed}: from the truth at frame 10, held: {held}");
+            }
             println!(
                 "| {seed} | {rig} | {} | {} | {} | {} | {} |",
                 r.acquired.map_or("never".into(), |k| k.to_string()),

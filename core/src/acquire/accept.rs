@@ -16,8 +16,8 @@ pub struct AcceptConfig {
 impl Default for AcceptConfig {
     fn default() -> Self {
         AcceptConfig {
-            min_score: 0.90,
-            min_camera_score: 0.86,
+            min_score: 0.93,
+            min_camera_score: 0.92,
         }
     }
 }

@@ -92,8 +92,13 @@ pub struct AcquireConfig {
     pub tree_levels: u8,
     /// First steps of the tree: palm rotation (rad), depth (share of the depth, one camera).
     pub tree_steps: [f32; 2],
+    /// The coarse level's cheaper score: points per silhouette line and silhouette grid
+    /// (the other levels use [`AcquireConfig::likelihood`]'s).
+    pub coarse_sampling: [u8; 2],
     /// Rounds of local refinement.
     pub refine_rounds: u8,
+    /// The best hypotheses refinement moves around (1..=[`MAX_KEEP`]).
+    pub refine_seeds: u8,
     /// First refinement steps: palm translation (mm), palm rotation (rad), finger bend (rad).
     pub refine_steps: [f32; 3],
     /// The score.
@@ -103,7 +108,7 @@ pub struct AcquireConfig {
 impl Default for AcquireConfig {
     fn default() -> Self {
         AcquireConfig {
-            evaluations_per_frame: 160,
+            evaluations_per_frame: 70,
             depths: 3,
             slide_step: 1.0 / 20.0,
             normals: 20,
@@ -111,7 +116,9 @@ impl Default for AcquireConfig {
             coarse_poses: 3,
             tree_levels: 3,
             tree_steps: [0.35, 0.15],
-            refine_rounds: 3,
+            coarse_sampling: [3, 10],
+            refine_rounds: 0,
+            refine_seeds: 4,
             refine_steps: [16.0, 0.2, 0.3],
             likelihood: LikelihoodConfig::default(),
         }
@@ -293,7 +300,18 @@ impl Acquirer {
                     self.fallback_position(cameras, &mut q);
                 }
             }
-            let (score, _) = self.score_cameras(model, cameras, frames, edges, &q);
+            let likelihood = match self.stage {
+                Stage::Coarse(_) => LikelihoodConfig {
+                    samples_per_line: self.config.coarse_sampling[0],
+                    silhouette_grid: self.config.coarse_sampling[1],
+                    ..self.config.likelihood
+                },
+                _ => self.config.likelihood,
+            };
+            let mut each = [Likelihood::default(); MAX_CAMERAS];
+            let n =
+                self.likelihoods_with(&likelihood, model, cameras, frames, edges, &q, &mut each);
+            let score = mean_score(&each[..n]);
             keep(&mut self.next, Candidate { score, q });
             evaluated = evaluated.saturating_add(self.finish_item(n_cameras.max(1) as u32));
         }
@@ -332,12 +350,15 @@ impl Acquirer {
     ) -> (f32, f32) {
         let mut each = [Likelihood::default(); MAX_CAMERAS];
         let n = self.likelihoods(model, cameras, frames, edges, q, &mut each);
-        let scores = each.iter().take(n).map(|l| l.score);
-        let worst = scores.clone().fold(f32::INFINITY, f32::min);
+        let worst = each
+            .iter()
+            .take(n)
+            .map(|l| l.score)
+            .fold(f32::INFINITY, f32::min);
         if n == 0 {
             (0.0, 0.0)
         } else {
-            (scores.sum::<f32>() / n as f32, worst)
+            (mean_score(&each[..n]), worst)
         }
     }
 
@@ -345,6 +366,22 @@ impl Acquirer {
     /// `q` cannot be posed).
     pub fn likelihoods(
         &mut self,
+        model: &Model,
+        cameras: &[Camera],
+        frames: &[FrameView<'_>],
+        edges: &[EdgeMap<'_>],
+        q: &[f32; MAX_STATES],
+        out: &mut [Likelihood; MAX_CAMERAS],
+    ) -> usize {
+        let config = self.config.likelihood;
+        self.likelihoods_with(&config, model, cameras, frames, edges, q, out)
+    }
+
+    /// [`Acquirer::likelihoods`] under `config`.
+    #[allow(clippy::too_many_arguments)]
+    fn likelihoods_with(
+        &mut self,
+        config: &LikelihoodConfig,
         model: &Model,
         cameras: &[Camera],
         frames: &[FrameView<'_>],
@@ -362,13 +399,7 @@ impl Acquirer {
             if !self.scratch.project(model, camera) {
                 return 0;
             }
-            *slot = evaluate(
-                &self.scratch.view,
-                camera,
-                frame,
-                edges,
-                &self.config.likelihood,
-            );
+            *slot = evaluate(&self.scratch.view, camera, frame, edges, config);
             n += 1;
         }
         n
@@ -617,7 +648,11 @@ impl Acquirer {
     /// Neighbour `next` of the refinement round `round` around the kept seeds.
     fn refined(&self, round: u8, next: u32) -> Option<[f32; MAX_STATES]> {
         const MOVES: u32 = 6 + 6 + 10;
-        let seed = self.best.get((next / MOVES) as usize)?;
+        let seeds = usize::from(self.config.refine_seeds).clamp(1, MAX_KEEP);
+        let seed = self
+            .best
+            .get(..seeds.min(self.best.len()))?
+            .get((next / MOVES) as usize)?;
         let m = next % MOVES;
         let scale = 1.0 / (1u32 << round) as f32;
         let [dt, dr, db] = self.config.refine_steps.map(|s| s * scale);
@@ -660,6 +695,15 @@ impl Acquirer {
 
     fn frees(&self, range: core::ops::Range<usize>) -> bool {
         range.into_iter().all(|s| self.free.contains(s))
+    }
+}
+
+/// The mean score of `each` (0 for none).
+fn mean_score(each: &[Likelihood]) -> f32 {
+    if each.is_empty() {
+        0.0
+    } else {
+        each.iter().map(|l| l.score).sum::<f32>() / each.len() as f32
     }
 }
 

@@ -126,6 +126,7 @@ fn back_project(camera: &Camera, uv: &Vector2<f32>, z: f32) -> Vector3<f32> {
 /// Moves the palm of `q` so the hypothesis lies over the regions of `cameras` (see the module
 /// doc). False when it cannot be placed (not posed, out of view, no region in the first
 /// camera). The palm stays within `volume`'s depth range from the first camera.
+#[allow(clippy::too_many_arguments)] // the search's scratch, the rig, the frame's regions and the hypothesis
 pub(crate) fn place(
     scratch: &mut Scratch,
     model: &Model,

@@ -26,8 +26,9 @@ pub const EDGE_BINS: usize = 6;
 pub const GRADIENT_STEP_PX: usize = 2;
 
 /// A cell's distance in chamfer units (3 per cell along a row or column, 4 diagonally),
-/// saturating here: 85 cells.
-const FAR: u8 = u8::MAX;
+/// held at most here (83 cells): low enough that adding 4 cannot overflow a `u8`, so the
+/// passes need no saturating arithmetic.
+const FAR: u8 = 250;
 
 /// The orientation bin of a line whose normal points at `angle` (rad, any value), and the
 /// other bin nearest it.
@@ -223,31 +224,54 @@ impl<'b> EdgeMap<'b> {
 /// left to right, from `other`, the row above; −1: right to left, from the row below).
 #[inline]
 fn relax_row(row: &mut [u8], other: &[u8], dir: i32) {
+    if dir > 0 {
+        relax_forward(row, other);
+    } else {
+        row.reverse();
+        // The other row reversed on the fly: the same pass, mirrored.
+        let mut mirrored = [FAR; MAX_PASS_CELLS];
+        let m = other.len().min(MAX_PASS_CELLS);
+        for (d, s) in mirrored.iter_mut().zip(other.iter().take(m).rev()) {
+            *d = *s;
+        }
+        relax_forward(row, mirrored.get(..m).unwrap_or(&[]));
+        row.reverse();
+    }
+}
+
+/// Cells of a row the mirrored pass handles with the row above or below (wider rows are
+/// relaxed along the row only).
+const MAX_PASS_CELLS: usize = 512;
+
+/// Left to right: each cell from the three cells of `other` above it (independent per
+/// cell), then from its left neighbour (a running minimum). Every value stays ≤ [`FAR`].
+#[inline]
+fn relax_forward(row: &mut [u8], other: &[u8]) {
     let n = row.len();
-    let has_other = other.len() == n;
-    let mut x = if dir > 0 { 0 } else { n as i32 - 1 };
-    let mut along = FAR;
-    for _ in 0..n {
-        let i = x as usize;
-        let mut d = row.get(i).copied().unwrap_or(FAR);
-        d = d.min(along.saturating_add(3));
-        if has_other {
-            let o = |j: i32| {
-                other
-                    .get(usize::try_from(j).unwrap_or(usize::MAX))
-                    .copied()
-                    .unwrap_or(FAR)
-            };
-            d = d
-                .min(o(x).saturating_add(3))
-                .min(o(x - 1).saturating_add(4))
-                .min(o(x + 1).saturating_add(4));
+    if other.len() == n && n > 1 {
+        if let (Some(first), Some(&o0), Some(&o1)) = (row.first_mut(), other.first(), other.get(1))
+        {
+            *first = (*first).min(o0 + 3).min(o1 + 4);
         }
-        if let Some(r) = row.get_mut(i) {
-            *r = d;
+        for (d, w) in row.iter_mut().skip(1).zip(other.windows(3)) {
+            let (ul, u, ur) = (w[0], w[1], w[2]);
+            *d = (*d).min(u + 3).min((ul + 4).min(ur + 4));
         }
-        along = d;
-        x += dir;
+        if let (Some(last), Some(&ol), Some(&o)) =
+            (row.last_mut(), other.get(n - 2), other.get(n - 1))
+        {
+            *last = (*last).min(o + 3).min(ol + 4);
+        }
+    } else if other.len() == n {
+        for (d, o) in row.iter_mut().zip(other) {
+            *d = (*d).min(o + 3);
+        }
+    }
+    let mut left = FAR;
+    for v in row.iter_mut() {
+        let d = (*v).min(left + 3).min(FAR);
+        *v = d;
+        left = d;
     }
 }
 
