@@ -1,11 +1,13 @@
 //! The tracker that finds the hand itself: the [`Status`] machine around the anytime
 //! [search](crate::acquire) and the Gauss–Newton [tracker](crate::tracker) (issue 10).
 //!
-//! - **Searching**: each frame moves the search on within its budget. When it is over, its
-//!   leaves are refined by the tracker's Gauss–Newton on the frames that follow, one leaf per
-//!   frame, and the best refined leaf is taken for the hand if its likelihood reaches the
-//!   acceptance score; otherwise the search starts over.
-//! - **Tracking**: the tracker runs; a lost frame makes the status [`Status::Lost`].
+//! - **Searching**: each frame moves the [`Finder`] on within its budget: the search places
+//!   and scores hypotheses; when it is over, its best leaves are refined by the tracker's
+//!   Gauss–Newton on the frames that follow and judged by the likelihood in every camera
+//!   ([`AcceptConfig`]); an accepted leaf is taken for the hand, and when every leaf is
+//!   refused the search starts over.
+//! - **Tracking**: the tracker runs — one hypothesis, or several ([`MultiTracker`], set by
+//!   [`AutoTracker::set_hypotheses`]); a lost frame makes the status [`Status::Lost`].
 //! - **Lost**: the tracker still runs (holding its last good state); a frame not lost makes it
 //!   `Tracking` again, [`LOST_FRAMES_BEFORE_SEARCH`] lost frames in a row make it `Searching`
 //!   (unless [`Recovery::Never`]: then it stays `Lost`, as the plain tracker does).
@@ -14,24 +16,27 @@
 //!   or two): each frame, the last good state is slid over each camera's edge map within
 //!   [`LOCAL_WINDOW`] of the frame's width of where it projects ([`Acquirer::place`]), each
 //!   placed state refined by the tracker's Gauss–Newton ([`LOCAL_REFINE_PASSES`] passes on the
-//!   frame), and the best taken for the hand if its likelihood reaches the acceptance score —
-//!   the same test as the search's leaves. The work per frame is bounded: one slide and
+//!   frame), and the best taken for the hand if the search's acceptance test takes it. The work per frame is bounded: one slide and
 //!   [`LOCAL_REFINE_PASSES`] tracker passes per camera. Only then does the global search run.
 //! - While searching, [`AutoTracker::state`] holds the last state that claimed the hand (the
 //!   base state before the first acquisition), never a refused hypothesis.
 //!
-//! The edge maps the search needs live in the caller's buffers, one per camera, of
-//! [`AutoTracker::edge_bytes_needed`] bytes; only searching frames build them.
+//! The edge maps the search (and several hypotheses) need live in the caller's buffers, one
+//! per camera, of [`AutoTracker::edge_bytes_needed`] bytes; only searching frames, and
+//! tracking frames with several hypotheses, build them.
 
 use core::fmt;
 
 use heapless::Vec;
 
-use crate::acquire::{AcquireConfig, Acquirer, Progress, WorkingVolume, MAX_KEEP};
+use crate::acquire::{
+    AcceptConfig, AcquireConfig, Acquirer, Finder, FinderConfig, FinderStep, WorkingVolume,
+};
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
+use crate::hypotheses::{HypothesesConfig, Hypothesis, MultiTracker};
 use crate::likelihood::{EdgeMap, LikelihoodError};
 use crate::model::Model;
 pub use crate::status::Status;
@@ -39,11 +44,6 @@ use crate::tracker::{FrameReport, Tracker, TrackerConfig, TrackerError};
 
 /// Lost frames in a row after which the tracker gives the hand up and searches again.
 pub const LOST_FRAMES_BEFORE_SEARCH: u32 = 10;
-
-/// The likelihood score (0..=1) a refined leaf needs to be taken for the hand: the true state
-/// scored 0.94–0.99 on six untuned random rigs at 320×240, wrong refined leaves up to 0.96
-/// (docs/recovery.md), so this refuses most wrong leaves and few right ones.
-pub const DEFAULT_ACCEPT_SCORE: f32 = 0.93;
 
 /// Searching frames after a loss spent on the local re-acquisition before the global search:
 /// two seconds at 30 frames/s, after the [`LOST_FRAMES_BEFORE_SEARCH`] lost frames.
@@ -117,24 +117,25 @@ pub struct AutoReport {
     pub report: FrameReport,
     /// Hypotheses the search scored on this frame.
     pub evaluated: u16,
-    /// The likelihood score of a leaf refined on this frame, accepted or not.
+    /// The mean likelihood score of the best leaf (or local hypothesis) refined on this
+    /// frame, accepted or not.
     pub leaf_score: Option<f32>,
     /// The frame was spent on the local re-acquisition around the last good state.
     pub local: bool,
+    /// Hypotheses carried to the next frame (1 with a single hypothesis and while searching).
+    pub hypotheses: u8,
+    /// The best hypothesis' likelihood score on a tracking frame with several hypotheses
+    /// (0 otherwise).
+    pub best_score: f32,
 }
 
 /// A tracker that finds the hand, tracks it, and finds it again.
 #[derive(Debug, Clone)]
 pub struct AutoTracker {
-    tracker: Tracker,
-    acquirer: Acquirer,
+    multi: MultiTracker,
+    finder: Finder,
     status: Status,
     lost_run: u32,
-    accept_score: f32,
-    /// The search's leaves still to refine (one per frame), best last.
-    leaves: Vec<[f32; MAX_STATES], MAX_KEEP>,
-    /// The best leaf refined so far in this round, and its score.
-    best_refined: Option<(f32, [f32; MAX_STATES])>,
     /// The state of the last frame that claimed the hand (the base before any).
     held: [f32; MAX_STATES],
     /// Whether `held` is a tracked state (else the base).
@@ -166,13 +167,10 @@ impl AutoTracker {
             *h = *s;
         }
         Ok(AutoTracker {
-            tracker,
-            acquirer,
+            multi: MultiTracker::new(tracker, HypothesesConfig::default()),
+            finder: Finder::new(acquirer, FinderConfig::default()),
             status: Status::Searching,
             lost_run: 0,
-            accept_score: DEFAULT_ACCEPT_SCORE,
-            leaves: Vec::new(),
-            best_refined: None,
             held,
             ever_tracked: false,
             local_left: 0,
@@ -206,9 +204,15 @@ impl AutoTracker {
         )
     }
 
-    /// Sets the score a refined leaf needs to be accepted.
-    pub fn set_accept_score(&mut self, score: f32) {
-        self.accept_score = score;
+    /// Sets the thresholds a refined leaf (or local hypothesis) must reach to be taken for
+    /// the hand.
+    pub fn set_accept(&mut self, accept: AcceptConfig) {
+        self.finder.set_accept(accept);
+    }
+
+    /// The acceptance thresholds.
+    pub fn accept(&self) -> AcceptConfig {
+        self.finder.config().accept
     }
 
     /// Sets what happens once the hand is lost for [`LOST_FRAMES_BEFORE_SEARCH`] frames.
@@ -216,13 +220,25 @@ impl AutoTracker {
         self.recovery = recovery;
     }
 
+    /// Sets how many hypotheses are tracked (one: the single tracker, bit for bit). Their
+    /// likelihood uses the search's edge-map buffers, so its stride must be the search's.
+    pub fn set_hypotheses(&mut self, config: HypothesesConfig) {
+        self.multi.set_config(config);
+    }
+
+    /// The hypotheses carried while tracking, best first (the last frame's).
+    pub fn hypotheses(&self) -> &[Hypothesis] {
+        self.multi.hypotheses()
+    }
+
     /// The state to report for the last frame: the tracker's while tracking or lost; while
     /// searching, the last state that claimed the hand (the base before the first
     /// acquisition), never a hypothesis under test.
     pub fn state(&self) -> &[f32] {
+        let tracker = self.multi.tracker();
         match self.status {
-            Status::Searching => &self.held[..self.tracker.state().len().min(MAX_STATES)],
-            Status::Tracking | Status::Lost => self.tracker.state(),
+            Status::Searching => &self.held[..tracker.state().len().min(MAX_STATES)],
+            Status::Tracking | Status::Lost => tracker.state(),
         }
     }
 
@@ -233,12 +249,17 @@ impl AutoTracker {
 
     /// The tracker (its model, cameras, free states).
     pub fn tracker(&self) -> &Tracker {
-        &self.tracker
+        self.multi.tracker()
     }
 
     /// The search.
     pub fn acquirer(&self) -> &Acquirer {
-        &self.acquirer
+        self.finder.acquirer()
+    }
+
+    /// The search and its leaves' judgement.
+    pub fn finder(&self) -> &Finder {
+        &self.finder
     }
 
     /// One instant: `frames[i]` is camera `i`'s, `edge_buffers[i]` its edge map's buffer.
@@ -249,19 +270,24 @@ impl AutoTracker {
     ) -> Result<AutoReport, AutoError> {
         match self.status {
             Status::Searching => self.search(frames, edge_buffers),
-            Status::Tracking | Status::Lost => self.follow(frames),
+            Status::Tracking | Status::Lost => self.follow(frames, edge_buffers),
         }
     }
 
     /// A tracking or lost frame: the tracker runs, the status follows its `lost` flag.
-    fn follow(&mut self, frames: &[FrameView<'_>]) -> Result<AutoReport, AutoError> {
-        let report = self.tracker.track(frames)?;
+    fn follow(
+        &mut self,
+        frames: &[FrameView<'_>],
+        edge_buffers: &mut [&mut [u8]],
+    ) -> Result<AutoReport, AutoError> {
+        let multi = self.multi.track(frames, edge_buffers)?;
+        let report = multi.report;
         if report.lost {
             self.lost_run = self.lost_run.saturating_add(1);
             self.status = if self.lost_run >= LOST_FRAMES_BEFORE_SEARCH
                 && self.recovery == Recovery::Search
             {
-                self.restart_search();
+                self.finder.restart();
                 self.following = None;
                 self.local_left = if self.ever_tracked {
                     LOCAL_SEARCH_FRAMES
@@ -283,37 +309,32 @@ impl AutoTracker {
             evaluated: 0,
             leaf_score: None,
             local: false,
+            hypotheses: multi.count,
+            best_score: multi.score,
         })
     }
 
     /// Keeps the tracker's state as the last that claimed the hand.
     fn hold_tracked(&mut self) {
-        for (h, s) in self.held.iter_mut().zip(self.tracker.state()) {
+        for (h, s) in self.held.iter_mut().zip(self.multi.tracker().state()) {
             *h = *s;
         }
         self.ever_tracked = true;
     }
 
-    fn restart_search(&mut self) {
-        self.acquirer.restart();
-        self.leaves.clear();
-        self.best_refined = None;
-    }
-
-    /// Takes `state` (refined on this frame) for the hand: the status becomes `Tracking`.
-    fn accept(&mut self, state: &[f32; MAX_STATES], n: usize) -> Result<(), AutoError> {
-        self.tracker.restart_fresh(&state[..n])?;
+    /// The tracker holds the hand (refined on this frame): the status becomes `Tracking`.
+    fn found(&mut self) {
+        self.multi.adopt();
         self.status = Status::Tracking;
         self.lost_run = 0;
         self.local_left = 0;
         self.hold_tracked();
-        Ok(())
     }
 
     /// One frame of local re-acquisition: the last good state slid over each camera's edge
     /// map near where it projects, and the hypothesis followed from the last frame (if any),
-    /// each refined by Gauss–Newton and scored over every camera; the best is accepted if its
-    /// score reaches the acceptance score, else followed to the next frame if it reaches
+    /// each refined by Gauss–Newton and scored over every camera; the best is accepted if the
+    /// acceptance test takes it, else followed to the next frame if it reaches
     /// [`LOCAL_FOLLOW_SCORE`].
     fn local_search(
         &mut self,
@@ -323,33 +344,37 @@ impl AutoTracker {
     ) -> Result<(), AutoError> {
         self.local_left = self.local_left.saturating_sub(1);
         out.local = true;
-        let n = self.tracker.model().n_states().min(MAX_STATES);
+        let n = self.multi.tracker().model().n_states().min(MAX_STATES);
         let seed = self.held;
-        let mut best: Option<(f32, [f32; MAX_STATES], FrameReport)> = None;
+        let mut best: Option<((f32, f32), [f32; MAX_STATES], FrameReport)> = None;
         let followed = self.following.take();
         for c in 0..=maps.len() {
-            let start = match (maps.get(c), self.tracker.cameras().get(c).copied()) {
+            let tracker = self.multi.tracker();
+            let start = match (maps.get(c), tracker.cameras().get(c).copied()) {
                 (Some(map), Some(camera)) => {
                     let near_px = camera.width as f32 * LOCAL_WINDOW;
-                    self.acquirer
-                        .place(self.tracker.model(), &camera, map, seed, Some(near_px))
+                    self.finder
+                        .acquirer_mut()
+                        .place(tracker.model(), &camera, map, seed, Some(near_px))
                         .map(|placed| placed.q)
                 }
                 _ => followed,
             };
             let Some(start) = start else { continue };
-            let (score, q, report) = self.refine(frames, maps, start, n)?;
+            let (scores, q, report) = self.refine(frames, maps, start, n)?;
             out.evaluated = out.evaluated.saturating_add(1);
-            if best.as_ref().is_none_or(|(s, _, _)| score > *s) {
-                best = Some((score, q, report));
+            if best.as_ref().is_none_or(|(s, _, _)| scores.0 > s.0) {
+                best = Some((scores, q, report));
             }
         }
-        let Some((score, q, report)) = best else {
+        let Some(((score, worst), q, report)) = best else {
             return Ok(());
         };
         out.leaf_score = Some(score);
-        if score >= self.accept_score {
-            self.accept(&q, n)?;
+        let verdict = self.finder.config().accept.judge(score, worst, report.lost);
+        if verdict.accepted {
+            self.multi.tracker_mut().restart_fresh(&q[..n])?;
+            self.found();
             out.status = Status::Tracking;
             out.report = FrameReport {
                 lost: false,
@@ -362,47 +387,49 @@ impl AutoTracker {
     }
 
     /// `start` refined by [`LOCAL_REFINE_PASSES`] fresh tracker passes on this frame, and its
-    /// likelihood score (0 when the tracker calls it lost).
+    /// mean and worst camera's likelihood score (0 when the tracker calls it lost).
     fn refine(
         &mut self,
         frames: &[FrameView<'_>],
         maps: &[EdgeMap<'_>],
         start: [f32; MAX_STATES],
         n: usize,
-    ) -> Result<(f32, [f32; MAX_STATES], FrameReport), AutoError> {
+    ) -> Result<((f32, f32), [f32; MAX_STATES], FrameReport), AutoError> {
         let mut q = start;
         let mut report = FrameReport::default();
+        let tracker = self.multi.tracker_mut();
         for _ in 0..LOCAL_REFINE_PASSES {
-            self.tracker.restart_fresh(&q[..n])?;
-            report = self.tracker.track(frames)?;
-            q[..n].copy_from_slice(&self.tracker.state()[..n]);
+            tracker.restart_fresh(&q[..n])?;
+            report = tracker.track(frames)?;
+            q[..n].copy_from_slice(&tracker.state()[..n]);
             if report.lost {
-                return Ok((0.0, q, report));
+                return Ok(((0.0, 0.0), q, report));
             }
         }
-        let score = self.acquirer.score(
-            self.tracker.model(),
-            self.tracker.cameras(),
+        let tracker = self.multi.tracker();
+        let scores = self.finder.acquirer_mut().score_cameras(
+            tracker.model(),
+            tracker.cameras(),
             frames,
             maps,
             &q,
         );
-        Ok((score, q, report))
+        Ok((scores, q, report))
     }
 
-    /// A searching frame: the search moves on, or one of its leaves is refined and judged.
+    /// A searching frame: the search moves on, or some of its leaves are refined and judged.
     fn search(
         &mut self,
         frames: &[FrameView<'_>],
         edge_buffers: &mut [&mut [u8]],
     ) -> Result<AutoReport, AutoError> {
-        if frames.len() != self.tracker.cameras().len() {
+        if frames.len() != self.multi.tracker().cameras().len() {
             return Err(AutoError::Tracker(TrackerError::FrameCount));
         }
         if edge_buffers.len() < frames.len() {
             return Err(AutoError::BufferCount);
         }
-        let config = *self.acquirer.config();
+        let config = *self.finder.acquirer().config();
         let mut maps: Vec<EdgeMap<'_>, MAX_CAMERAS> = Vec::new();
         for (buffer, frame) in edge_buffers.iter_mut().zip(frames) {
             let map =
@@ -417,68 +444,31 @@ impl AutoTracker {
                 lost: true,
                 ..FrameReport::default()
             },
-            evaluated: 0,
-            leaf_score: None,
-            local: false,
+            hypotheses: 1,
+            ..AutoReport::default()
         };
         if self.local_left > 0 {
             self.local_search(frames, &maps, &mut out)?;
             return Ok(out);
         }
-        if self.leaves.is_empty() {
-            match self
-                .acquirer
-                .step(self.tracker.model(), self.tracker.cameras(), frames, &maps)
-            {
-                Progress::Searching { evaluated } => out.evaluated = evaluated,
-                Progress::Found(_) => {
-                    // Refine the leaves one per frame, best last (popped first).
-                    self.leaves.clear();
-                    for c in self.acquirer.best().iter().rev() {
-                        let _ = self.leaves.push(c.q);
-                    }
-                    self.best_refined = None;
-                }
+        match self.finder.step(self.multi.tracker_mut(), frames, &maps)? {
+            FinderStep::Searching {
+                evaluated,
+                best_leaf,
+                ..
+            } => {
+                out.evaluated = evaluated;
+                out.leaf_score = best_leaf.map(|v| v.score);
             }
-            return Ok(out);
-        }
-        let Some(leaf) = self.leaves.pop() else {
-            return Ok(out);
-        };
-        let n = self.tracker.model().n_states().min(MAX_STATES);
-        self.tracker.restart_fresh(&leaf[..n])?;
-        let report = self.tracker.track(frames)?;
-        let mut refined = [0.0f32; MAX_STATES];
-        refined[..n].copy_from_slice(&self.tracker.state()[..n]);
-        let score = if report.lost {
-            0.0
-        } else {
-            self.acquirer.score(
-                self.tracker.model(),
-                self.tracker.cameras(),
-                frames,
-                &maps,
-                &refined,
-            )
-        };
-        out.leaf_score = Some(score);
-        if self.best_refined.is_none_or(|(s, _)| score > s) {
-            self.best_refined = Some((score, refined));
-        }
-        if !self.leaves.is_empty() {
-            return Ok(out);
-        }
-        // Every leaf refined: take the best, if it explains the frame well enough.
-        match self.best_refined.take() {
-            Some((score, state)) if score >= self.accept_score => {
-                self.accept(&state, n)?;
+            FinderStep::Found { verdict, report } => {
+                self.found();
+                out.leaf_score = Some(verdict.score);
                 out.status = Status::Tracking;
                 out.report = FrameReport {
                     lost: false,
                     ..report
                 };
             }
-            _ => self.restart_search(),
         }
         Ok(out)
     }

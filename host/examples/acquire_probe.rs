@@ -1,44 +1,102 @@
-//! How well the search finds the hand from nothing: renders seeds of the random rigs, tracks
-//! each with no initial state (`AutoTracker`), and prints per seed the frame where the hand
-//! was acquired (fingertips within 10 px at 640 px wide, held 5 frames), the leaf scores it
-//! tried, and the truth's own score.
+//! How well the search finds the hand from nothing, over seeds of the random rigs.
+//!
+//! Each seed is rendered as `random-mono` and `random-stereo` (at `--width`, 320×240 by
+//! default) and run from no initial state through a status machine like the tracker's:
+//! Searching (the core's `Finder`: the search within its budget, then a few leaves a frame
+//! refined by Gauss–Newton and judged) → Tracking → Lost → Searching after 10 lost frames.
+//! A rig is *acquired* at frame k when frames k..k+5 are all tracked with a mean fingertip
+//! error within 10 px at 640 px wide (scaled to the width), and k < `--within`.
+//!
+//! It prints one row per run and a summary per rig, and can write every refined leaf's
+//! judgement and its true error (`--leaves-csv`), and the judgements of leaves refined on
+//! hand-free frames (`--hand-free N`): the distributions the acceptance thresholds are set
+//! from (docs/recovery.md).
 //!
 //! ```text
-//! cargo run --release -p digiteyes-host --example acquire_probe -- --seeds 301..=310
+//! cargo run --release -p digiteyes-host --example acquire_probe -- --seeds 401..=440
 //! ```
 
+use std::io::Write;
 use std::ops::RangeInclusive;
 
-use anyhow::Result;
+use anyhow::{anyhow, Result};
 use clap::Parser;
-use digiteyes_core::acquire::AcquireConfig;
+use digiteyes_core::acquire::{
+    AcceptConfig, AcquireConfig, Acquirer, Finder, FinderConfig, FinderStep, WorkingVolume,
+};
+use digiteyes_core::camera::Camera;
+use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::frame::FrameView;
-use digiteyes_host::acquire::{AutoTracker, Status};
-use digiteyes_host::eval::compare;
+use digiteyes_core::kinematics::Poses;
+use digiteyes_core::likelihood::EdgeMap;
+use digiteyes_core::model::{Model, Shape};
+use digiteyes_core::tracker::Tracker;
 use digiteyes_host::scenarios::{render_scenario, RenderOptions};
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::TrackerConfig;
 
+/// Lost frames in a row after which the probe's status machine searches again (as the
+/// tracker's does).
+const LOST_FRAMES_BEFORE_SEARCH: u32 = 10;
+
+/// Frames a claimed hand must be held, right, to count as acquired.
+const HELD_FRAMES: usize = 5;
+
 #[derive(Parser)]
 struct Args {
-    #[arg(long, value_parser = parse_range, default_value = "301..=306")]
+    #[arg(long, value_parser = parse_range, default_value = "101..=110")]
     seeds: RangeInclusive<u64>,
-    #[arg(long, default_value_t = 60)]
+    /// Rigs to run each seed on: mono, stereo or both.
+    #[arg(long, default_value = "mono,stereo", value_delimiter = ',')]
+    rigs: Vec<String>,
+    #[arg(long, default_value_t = 40)]
     frames: usize,
+    /// Acquired only if the held run starts before this frame.
+    #[arg(long, default_value_t = 30)]
+    within: usize,
     #[arg(long, default_value_t = 320)]
     width: u32,
-    #[arg(long, default_value_t = 1000)]
-    budget: u16,
-    #[arg(long, default_value_t = 20)]
-    normals: u8,
-    #[arg(long, default_value_t = 6)]
-    spins: u8,
-    #[arg(long, default_value_t = 3)]
-    depths: u8,
-    #[arg(long, default_value_t = 4)]
-    rounds: u8,
-    #[arg(long, default_value_t = 0.80)]
-    accept: f32,
+    #[arg(long)]
+    budget: Option<u16>,
+    #[arg(long)]
+    normals: Option<u8>,
+    #[arg(long)]
+    spins: Option<u8>,
+    #[arg(long)]
+    coarse_poses: Option<u8>,
+    #[arg(long)]
+    tree_levels: Option<u8>,
+    #[arg(long)]
+    rounds: Option<u8>,
+    #[arg(long)]
+    refine_seeds: Option<u8>,
+    /// The coarse level's points per line and silhouette grid, e.g. 3,10.
+    #[arg(long, value_delimiter = ',')]
+    coarse_sampling: Option<Vec<u8>>,
+    #[arg(long)]
+    leaves_per_frame: Option<u8>,
+    #[arg(long)]
+    leaves: Option<u8>,
+    #[arg(long)]
+    passes: Option<u8>,
+    #[arg(long)]
+    min_score: Option<f32>,
+    #[arg(long)]
+    min_camera_score: Option<f32>,
+    /// Write every refined leaf's judgement and true error here (CSV).
+    #[arg(long)]
+    leaves_csv: Option<std::path::PathBuf>,
+    /// Also run this many hand-free frames (plain, noisy, cluttered, in turn) through the
+    /// search with acceptance off, and write their leaves' judgements to the CSV.
+    #[arg(long, default_value_t = 0)]
+    hand_free: usize,
+    /// Also start the tracker at the truth of frame 10 and report whether it holds the hand
+    /// (within the limit) for the next 5 frames: the most any search could give.
+    #[arg(long)]
+    oracle: bool,
+    /// Print each run's frame-by-frame statuses.
+    #[arg(long)]
+    verbose: bool,
 }
 
 fn parse_range(s: &str) -> Result<RangeInclusive<u64>, String> {
@@ -46,164 +104,448 @@ fn parse_range(s: &str) -> Result<RangeInclusive<u64>, String> {
     Ok(a.parse().map_err(|_| "A")?..=b.parse().map_err(|_| "B")?)
 }
 
+fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
+    let d = AcquireConfig::default();
+    let acquire = AcquireConfig {
+        evaluations_per_frame: args.budget.unwrap_or(d.evaluations_per_frame),
+        normals: args.normals.unwrap_or(d.normals),
+        spins: args.spins.unwrap_or(d.spins),
+        coarse_poses: args.coarse_poses.unwrap_or(d.coarse_poses),
+        tree_levels: args.tree_levels.unwrap_or(d.tree_levels),
+        refine_rounds: args.rounds.unwrap_or(d.refine_rounds),
+        refine_seeds: args.refine_seeds.unwrap_or(d.refine_seeds),
+        coarse_sampling: match args.coarse_sampling.as_deref() {
+            Some([a, b]) => [*a, *b],
+            _ => d.coarse_sampling,
+        },
+        ..d
+    };
+    let f = FinderConfig::default();
+    let finder = FinderConfig {
+        leaves_per_frame: args.leaves_per_frame.unwrap_or(f.leaves_per_frame),
+        leaves: args.leaves.unwrap_or(f.leaves),
+        passes_per_leaf: args.passes.unwrap_or(f.passes_per_leaf),
+        accept: AcceptConfig {
+            min_score: args.min_score.unwrap_or(f.accept.min_score),
+            min_camera_score: args.min_camera_score.unwrap_or(f.accept.min_camera_score),
+        },
+    };
+    (acquire, finder)
+}
+
+/// Mean fingertip distance (px) between states `a` and `b` over every camera.
+fn tip_error_px(model: &Model, cameras: &[Camera], a: &[f32], b: &[f32]) -> f32 {
+    let (Ok(pa), Ok(pb)) = (Poses::compute(model, a), Poses::compute(model, b)) else {
+        return f32::INFINITY;
+    };
+    let tips: Vec<usize> = (0..model.links().len())
+        .filter(|&i| matches!(model.links()[i].shape, Shape::Tip { .. }))
+        .collect();
+    let (mut sum, mut n) = (0.0f32, 0u32);
+    for c in cameras {
+        for &t in &tips {
+            let (Some(x), Some(y)) = (pa.origin(t), pb.origin(t)) else {
+                continue;
+            };
+            match (c.project(&x), c.project(&y)) {
+                (Some(u), Some(v)) => sum += (u - v).norm(),
+                _ => sum += 1e3,
+            }
+            n += 1;
+        }
+    }
+    if n == 0 {
+        f32::INFINITY
+    } else {
+        sum / n as f32
+    }
+}
+
+/// One run's outcome.
+struct Run {
+    acquired: Option<usize>,
+    /// Tip error (px) of the leaf accepted first, and its frame.
+    first_claim: Option<(usize, f32)>,
+    /// Frames claimed with a tip error over the limit.
+    wrong_frames: usize,
+    evaluations: u64,
+    refined: u32,
+}
+
+/// Edge maps of `views` in `buffers`.
+fn edge_maps<'b>(
+    buffers: &'b mut [Vec<u8>],
+    views: &[FrameView<'_>],
+    acquire: &AcquireConfig,
+) -> Result<Vec<EdgeMap<'b>>> {
+    buffers
+        .iter_mut()
+        .zip(views)
+        .map(|(b, v)| EdgeMap::build(b, v, &acquire.likelihood).map_err(|e| anyhow!("{e}")))
+        .collect()
+}
+
+fn buffers(cameras: &[Camera], acquire: &AcquireConfig) -> Vec<Vec<u8>> {
+    cameras
+        .iter()
+        .map(|c| {
+            vec![
+                0u8;
+                EdgeMap::bytes_needed(
+                    c.width as usize,
+                    c.height as usize,
+                    acquire.likelihood.stride_px
+                )
+            ]
+        })
+        .collect()
+}
+
+fn new_finder(sequence: &Sequence, base: &[f32], args: &Args) -> Result<(Tracker, Finder)> {
+    let (acquire, finder) = configs(args);
+    let tracker = Tracker::new(
+        sequence.model.clone(),
+        &sequence.cameras,
+        base,
+        sequence.free_mask(),
+        TrackerConfig::default(),
+    )
+    .map_err(|e| anyhow!("{e}"))?;
+    let volume = WorkingVolume::from_cameras(&sequence.cameras, 600.0);
+    let acquirer = Acquirer::new(tracker.model(), base, tracker.free(), volume, acquire);
+    Ok((tracker, Finder::new(acquirer, finder)))
+}
+
+fn run(
+    sequence: &Sequence,
+    args: &Args,
+    label: &str,
+    csv: &mut Option<std::fs::File>,
+) -> Result<Run> {
+    let truth = sequence.read_truth()?;
+    let (acquire, _) = configs(args);
+    let mut base = vec![0.0f32; sequence.n_states()];
+    base[0] = 1.0;
+    let (mut tracker, mut finder) = new_finder(sequence, &base, args)?;
+    let limit = 10.0 * args.width as f32 / 640.0;
+    let mut bufs = buffers(&sequence.cameras, &acquire);
+    let mut searching = true;
+    let mut lost_run = 0;
+    let mut good = Vec::new();
+    let mut out = Run {
+        acquired: None,
+        first_claim: None,
+        wrong_frames: 0,
+        evaluations: 0,
+        refined: 0,
+    };
+    let mut line = String::new();
+    for k in 0..sequence.frames {
+        let images: Vec<_> = (0..sequence.cameras.len())
+            .map(|c| sequence.read_frame(c, k))
+            .collect::<Result<_>>()?;
+        let views: Vec<_> = images
+            .iter()
+            .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
+            .collect::<Result<_, _>>()?;
+        let truth_k: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
+        let claimed = if searching {
+            let maps = edge_maps(&mut bufs, &views, &acquire)?;
+            let step = finder
+                .step(&mut tracker, &views, &maps)
+                .map_err(|e| anyhow!("{e}"))?;
+            if let Some((verdict, q)) = finder.last_leaf() {
+                let n = sequence.n_states();
+                let e = tip_error_px(&sequence.model, &sequence.cameras, &q[..n], &truth_k);
+                if let Some(f) = csv.as_mut() {
+                    writeln!(
+                        f,
+                        "{label},{k},{:.4},{:.4},{},{},{e:.2}",
+                        verdict.score,
+                        verdict.worst_camera,
+                        u8::from(verdict.lost),
+                        u8::from(verdict.accepted)
+                    )?;
+                }
+            }
+            match step {
+                FinderStep::Searching {
+                    evaluated, refined, ..
+                } => {
+                    out.evaluations += u64::from(evaluated);
+                    out.refined += u32::from(refined);
+                    line.push(if refined > 0 { 'r' } else { '.' });
+                    false
+                }
+                FinderStep::Found { .. } => {
+                    out.refined += 1;
+                    searching = false;
+                    lost_run = 0;
+                    line.push('F');
+                    true
+                }
+            }
+        } else {
+            let report = tracker.track(&views).map_err(|e| anyhow!("{e}"))?;
+            if report.lost {
+                lost_run += 1;
+                line.push('l');
+                if lost_run >= LOST_FRAMES_BEFORE_SEARCH {
+                    searching = true;
+                    finder.restart();
+                }
+                false
+            } else {
+                lost_run = 0;
+                line.push('t');
+                true
+            }
+        };
+        let e = if claimed {
+            tip_error_px(
+                &sequence.model,
+                &sequence.cameras,
+                tracker.state(),
+                &truth_k,
+            )
+        } else {
+            f32::INFINITY
+        };
+        if claimed && out.first_claim.is_none() {
+            out.first_claim = Some((k, e));
+        }
+        if claimed && e > limit {
+            out.wrong_frames += 1;
+        }
+        good.push(claimed && e <= limit);
+    }
+    out.acquired = (0..good.len().saturating_sub(HELD_FRAMES - 1))
+        .filter(|&k| k < args.within)
+        .find(|&k| good[k..k + HELD_FRAMES].iter().all(|&g| g));
+    if args.verbose {
+        eprintln!("{label}: {line}");
+    }
+    Ok(out)
+}
+
+/// Whether the tracker started at the truth of frame `start` holds the hand within `limit`
+/// for [`HELD_FRAMES`] frames (the first tracked on `start` itself).
+fn oracle_holds(sequence: &Sequence, start: usize, limit: f32) -> Result<bool> {
+    let truth = sequence.read_truth()?;
+    let q: Vec<f32> = truth.rows[start].iter().map(|&v| v as f32).collect();
+    let mut tracker = Tracker::new(
+        sequence.model.clone(),
+        &sequence.cameras,
+        &q,
+        sequence.free_mask(),
+        TrackerConfig::default(),
+    )
+    .map_err(|e| anyhow!("{e}"))?;
+    for k in start..start + HELD_FRAMES {
+        let images: Vec<_> = (0..sequence.cameras.len())
+            .map(|c| sequence.read_frame(c, k))
+            .collect::<Result<_>>()?;
+        let views: Vec<_> = images
+            .iter()
+            .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
+            .collect::<Result<_, _>>()?;
+        let report = tracker.track(&views).map_err(|e| anyhow!("{e}"))?;
+        let t: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
+        let e = tip_error_px(&sequence.model, &sequence.cameras, tracker.state(), &t);
+        if report.lost || e > limit {
+            return Ok(false);
+        }
+    }
+    Ok(true)
+}
+
+/// A hand-free frame: a grey background, optional noise, optional clutter (bright and dark
+/// bars at every angle), from a small deterministic generator (as tests/tests/acquire.rs).
+fn hand_free(w: usize, h: usize, grey: u8, noise: u8, clutter: bool, seed: u64) -> Vec<u8> {
+    let mut state = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 33) as u32
+    };
+    let mut pixels = vec![grey; w * h];
+    if clutter {
+        for _ in 0..25 {
+            let (cx, cy) = (next() as usize % w, next() as usize % h);
+            let angle = (next() % 360) as f32 * std::f32::consts::PI / 180.0;
+            let (len, half) = (20 + next() as usize % 80, 2 + next() as usize % 5);
+            let level = if next() % 2 == 0 { 230 } else { 20 };
+            for t in 0..len {
+                for s in 0..2 * half {
+                    let x =
+                        cx as f32 + angle.cos() * t as f32 - angle.sin() * (s as f32 - half as f32);
+                    let y =
+                        cy as f32 + angle.sin() * t as f32 + angle.cos() * (s as f32 - half as f32);
+                    if x >= 0.0 && y >= 0.0 && (x as usize) < w && (y as usize) < h {
+                        pixels[y as usize * w + x as usize] = level;
+                    }
+                }
+            }
+        }
+    }
+    if noise > 0 {
+        for p in &mut pixels {
+            let n = (next() % (2 * u32::from(noise) + 1)) as i32 - i32::from(noise);
+            *p = (i32::from(*p) + n).clamp(0, 255) as u8;
+        }
+    }
+    pixels
+}
+
+/// Hand-free frames through the search with acceptance off: every leaf's judgement.
+fn hand_free_run(sequence: &Sequence, args: &Args, csv: &mut Option<std::fs::File>) -> Result<f32> {
+    let mut base = vec![0.0f32; sequence.n_states()];
+    base[0] = 1.0;
+    let (acquire, _) = configs(args);
+    let mut args_off = Args::parse_from(["probe"]);
+    args_off.min_score = Some(2.0);
+    args_off.budget = Some(u16::MAX);
+    args_off.leaves_per_frame = Some(8);
+    args_off.leaves = args.leaves;
+    let (mut tracker, mut finder) = new_finder(sequence, &base, &args_off)?;
+    let mut bufs = buffers(&sequence.cameras, &acquire);
+    let mut worst = 0.0f32;
+    let kinds = [
+        (0u8, false, "plain"),
+        (8, false, "noisy"),
+        (8, true, "cluttered"),
+        (0, true, "clutter"),
+    ];
+    let mut k = 0;
+    while k < args.hand_free {
+        let (noise, clutter, kind) = kinds[k % kinds.len()];
+        let frames: Vec<Vec<u8>> = sequence
+            .cameras
+            .iter()
+            .enumerate()
+            .map(|(c, cam)| {
+                let grey = 30 + (k * 7 % 40) as u8;
+                hand_free(
+                    cam.width as usize,
+                    cam.height as usize,
+                    grey,
+                    noise,
+                    clutter,
+                    (k * 4 + c) as u64,
+                )
+            })
+            .collect();
+        let views: Vec<_> = frames
+            .iter()
+            .zip(&sequence.cameras)
+            .map(|(p, c)| FrameView::packed(p, c.width as usize, c.height as usize))
+            .collect::<Result<_, _>>()?;
+        // The search to its end on this frame, then its leaves on the same frame.
+        loop {
+            let maps = edge_maps(&mut bufs, &views, &acquire)?;
+            finder
+                .step(&mut tracker, &views, &maps)
+                .map_err(|e| anyhow!("{e}"))?;
+            if let Some((verdict, _)) = finder.last_leaf() {
+                worst = worst.max(verdict.score);
+                if let Some(f) = csv.as_mut() {
+                    writeln!(
+                        f,
+                        "hand-free-{kind}-{},{k},{:.4},{:.4},{},0,inf",
+                        sequence.cameras.len(),
+                        verdict.score,
+                        verdict.worst_camera,
+                        u8::from(verdict.lost)
+                    )?;
+                }
+                break;
+            }
+        }
+        finder.restart();
+        k += 1;
+    }
+    Ok(worst)
+}
+
 fn main() -> Result<()> {
     let args = Args::parse();
     let dir = tempfile::tempdir()?;
     let (w, h) = (args.width, args.width * 3 / 4);
-    println!(
-        "| seed | rig | acquired at | tries (leaf scores) | evaluations | frame-0 truth score |"
-    );
-    println!("|---|---|---|---|---|---|");
+    let mut csv = match &args.leaves_csv {
+        Some(p) => {
+            let mut f = std::fs::File::create(p)?;
+            writeln!(f, "run,frame,score,worst_camera,lost,accepted,tip_error_px")?;
+            Some(f)
+        }
+        None => None,
+    };
+    println!("| seed | rig | acquired at | first claim (frame: tip px) | wrong frames | evaluations | leaves refined |");
+    println!("|---|---|---|---|---|---|---|");
+    let mut summary: Vec<(String, Vec<Run>)> =
+        args.rigs.iter().map(|r| (r.clone(), Vec::new())).collect();
     for seed in args.seeds.clone() {
-        let stereo = seed % 2 == 0;
-        let name = if stereo {
-            "random-stereo"
-        } else {
-            "random-mono"
-        };
-        let seq = dir.path().join(format!("s{seed}"));
-        let options = RenderOptions {
-            seed,
-            frames: Some(args.frames),
-            size: Some((w, h)),
-            supersample: 2,
-            ..RenderOptions::default()
-        };
-        render_scenario(name, &seq, &options)?;
-        let sequence = Sequence::open(&seq)?;
-        let truth = sequence.read_truth()?;
-        let mut base: Vec<f32> = vec![0.0; sequence.n_states()];
-        base[0] = 1.0;
-        let acquire = AcquireConfig {
-            evaluations_per_frame: args.budget,
-            normals: args.normals,
-            spins: args.spins,
-            depths: args.depths,
-            refine_rounds: args.rounds,
-            ..AcquireConfig::default()
-        };
-        let mut auto = AutoTracker::new(
-            sequence.model.clone(),
-            &sequence.cameras,
-            &base,
-            sequence.free_mask(),
-            TrackerConfig::default(),
-            acquire,
-        )?;
-        auto.set_accept_score(args.accept);
-        let mut estimated = Vec::new();
-        let mut statuses = Vec::new();
-        let mut leaves = Vec::new();
-        let mut evaluations = 0u32;
-        for k in 0..sequence.frames {
-            let images: Vec<_> = (0..sequence.cameras.len())
-                .map(|c| sequence.read_frame(c, k))
-                .collect::<Result<_>>()?;
-            let views: Vec<_> = images
-                .iter()
-                .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
-                .collect::<Result<_, _>>()?;
-            let r = auto.step(&views)?;
-            evaluations += u32::from(r.evaluated);
-            if let Some(s) = r.leaf_score {
-                leaves.push(format!("{s:.2}@{k}"));
+        for (rig, runs) in summary.iter_mut() {
+            let name = format!("random-{rig}");
+            let seq = dir.path().join(format!("{rig}{seed}"));
+            let options = RenderOptions {
+                seed,
+                frames: Some(args.frames),
+                size: Some((w, h)),
+                ..RenderOptions::default()
+            };
+            render_scenario(&name, &seq, &options)?;
+            let sequence = Sequence::open(&seq)?;
+            let r = run(&sequence, &args, &format!("{rig}-{seed}"), &mut csv)?;
+            if args.oracle {
+                let held = oracle_holds(&sequence, 10, 10.0 * args.width as f32 / 640.0)?;
+                eprintln!("{rig}-{seed}: from the truth at frame 10, held: {held}");
             }
-            statuses.push(r.status);
-            estimated.push(
-                auto.state()
-                    .iter()
-                    .map(|&v| f64::from(v))
-                    .collect::<Vec<_>>(),
+            println!(
+                "| {seed} | {rig} | {} | {} | {} | {} | {} |",
+                r.acquired.map_or("never".into(), |k| k.to_string()),
+                r.first_claim
+                    .map_or("-".into(), |(k, e)| format!("{k}: {e:.1}")),
+                r.wrong_frames,
+                r.evaluations,
+                r.refined
             );
+            if seed == *args.seeds.start() && args.hand_free > 0 {
+                let worst = hand_free_run(&sequence, &args, &mut csv)?;
+                eprintln!(
+                    "{rig}: {} hand-free frames, best leaf score {worst:.3}",
+                    args.hand_free
+                );
+            }
+            std::fs::remove_dir_all(&seq)?;
+            runs.push(r);
         }
-        let names: Vec<String> = (0..sequence.cameras.len())
-            .map(|c| format!("cam{c}"))
+    }
+    for (rig, runs) in &summary {
+        let n = runs.len();
+        let mut frames: Vec<usize> = runs.iter().filter_map(|r| r.acquired).collect();
+        frames.sort();
+        let mut errors: Vec<f32> = runs
+            .iter()
+            .filter_map(|r| r.first_claim.map(|(_, e)| e))
             .collect();
-        let free: Vec<usize> = (0..sequence.n_states()).collect();
-        let report = compare(
-            &sequence.model,
-            &sequence.cameras,
-            &names,
-            &free,
-            &truth.rows,
-            &estimated,
-        )?;
-        let limit = 10.0 * f64::from(w) / 640.0;
-        let tips = &report.fingertip_mean_by_frame;
-        let acquired = (0..tips.len().saturating_sub(4))
-            .find(|&k| (k..k + 5).all(|j| statuses[j] == Status::Tracking && tips[j] <= limit));
-        // The truth's score on frame 0, for the acceptance threshold.
-        let truth_score = {
-            let images: Vec<_> = (0..sequence.cameras.len())
-                .map(|c| sequence.read_frame(c, 0))
-                .collect::<Result<_>>()?;
-            let views: Vec<_> = images
-                .iter()
-                .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
-                .collect::<Result<_, _>>()?;
-            let mut buffers: Vec<Vec<u8>> = views
-                .iter()
-                .map(|v| {
-                    vec![
-                        0;
-                        digiteyes_core::likelihood::EdgeMap::bytes_needed(
-                            v.width(),
-                            v.height(),
-                            acquire.likelihood.stride_px
-                        )
-                    ]
-                })
-                .collect();
-            let maps: Vec<_> = buffers
-                .iter_mut()
-                .zip(&views)
-                .map(|(b, v)| digiteyes_core::likelihood::EdgeMap::build(b, v, &acquire.likelihood))
-                .collect::<Result<_, _>>()
-                .map_err(|e| anyhow::anyhow!("{e}"))?;
-            let mut q = [0.0f32; digiteyes_core::config::MAX_STATES];
-            for (d, s) in q.iter_mut().zip(&truth.rows[0]) {
-                *d = *s as f32;
-            }
-            let mut probe = digiteyes_core::acquire::Acquirer::new(
-                &sequence.model,
-                &base,
-                auto.tracker().free(),
-                digiteyes_core::acquire::WorkingVolume::from_cameras(&sequence.cameras, 600.0),
-                acquire,
-            );
-            if let Some(placed) =
-                probe.place(&sequence.model, &sequence.cameras[0], &maps[0], q, None)
-            {
-                let d = (4..7)
-                    .map(|i| (placed.q[i] - q[i]).powi(2))
-                    .sum::<f32>()
-                    .sqrt();
-                let full =
-                    probe.score(&sequence.model, &sequence.cameras, &views, &maps, &placed.q);
-                eprintln!("seed {seed}: the truth slid: {d:.1} mm away, chamfer score {:.2}, full {full:.2}", placed.score);
-            }
-            probe.score(&sequence.model, &sequence.cameras, &views, &maps, &q)
-        };
-        if let Some(k) = statuses.iter().position(|s| *s == Status::Tracking) {
-            let e = &estimated[k];
-            let t = &truth.rows[k];
-            let palm = (4..7).map(|i| (e[i] - t[i]).powi(2)).sum::<f64>().sqrt();
-            let dot = (0..4).map(|i| e[i] * t[i]).sum::<f64>().abs().min(1.0);
-            let joints =
-                (7..e.len()).map(|i| (e[i] - t[i]).powi(2)).sum::<f64>() / (e.len() - 7) as f64;
-            eprintln!(
-                "seed {seed}: claimed at {k}: tips {:.1} px, palm {palm:.0} mm, {:.0} deg, joints {:.0} deg RMS",
-                tips[k],
-                (2.0 * dot.acos()).to_degrees(),
-                joints.sqrt().to_degrees()
-            );
-        }
+        errors.sort_by(f32::total_cmp);
+        let wrong: usize = runs.iter().map(|r| r.wrong_frames).sum();
+        let pct = |v: &[usize], p: usize| v.get((v.len().max(1) - 1) * p / 100).copied();
         println!(
-            "| {seed} | {} | {} | {} | {evaluations} | {truth_score:.2} |",
-            if stereo { "stereo" } else { "mono" },
-            acquired.map_or("never".to_string(), |k| k.to_string()),
-            leaves.join(" "),
+            "{rig}: acquired {}/{n} ({:.0} %); frames to acquire: min {:?}, median {:?}, max {:?}; \
+             first claim's tip error (px at {w}): median {:?}, max {:?}; {} of {n} runs claimed; \
+             {wrong} claimed frames wrong",
+            frames.len(),
+            100.0 * frames.len() as f32 / n.max(1) as f32,
+            frames.first(),
+            pct(&frames, 50),
+            frames.last(),
+            errors.get(errors.len() / 2),
+            errors.last(),
+            errors.len(),
         );
     }
+    let _ = MAX_STATES;
     Ok(())
 }

@@ -2,15 +2,16 @@
 //! edge-map buffers owned here (a board keeps them in static memory instead).
 
 use anyhow::{anyhow, Result};
-use digiteyes_core::acquire::AcquireConfig;
+use digiteyes_core::acquire::{AcceptConfig, AcquireConfig};
 use digiteyes_core::auto_tracker::AutoTracker as CoreAutoTracker;
 pub use digiteyes_core::auto_tracker::{
-    AutoReport, Recovery, Status, DEFAULT_ACCEPT_SCORE, FALLBACK_DEPTH_MM, LOCAL_REFINE_PASSES,
-    LOCAL_SEARCH_FRAMES, LOCAL_WINDOW, LOST_FRAMES_BEFORE_SEARCH,
+    AutoReport, Recovery, Status, FALLBACK_DEPTH_MM, LOCAL_REFINE_PASSES, LOCAL_SEARCH_FRAMES,
+    LOCAL_WINDOW, LOST_FRAMES_BEFORE_SEARCH,
 };
 use digiteyes_core::camera::Camera;
 use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
+use digiteyes_core::hypotheses::HypothesesConfig;
 use digiteyes_core::model::Model;
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
 
@@ -67,9 +68,14 @@ impl AutoTracker {
         self.inner.set_recovery(recovery);
     }
 
-    /// Sets the score a refined leaf needs to be accepted.
-    pub fn set_accept_score(&mut self, score: f32) {
-        self.inner.set_accept_score(score);
+    /// Sets the thresholds a refined leaf needs to be accepted.
+    pub fn set_accept(&mut self, accept: AcceptConfig) {
+        self.inner.set_accept(accept);
+    }
+
+    /// Sets how many hypotheses are tracked (one: the single tracker, bit for bit).
+    pub fn set_hypotheses(&mut self, config: HypothesesConfig) {
+        self.inner.set_hypotheses(config);
     }
 
     /// The current state (the last tracked one, or the base while searching).

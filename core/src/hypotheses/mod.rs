@@ -109,6 +109,30 @@ impl MultiTracker {
         &self.tracker
     }
 
+    /// The tracker, for a caller that moves it outside the hypotheses (the search refining
+    /// a leaf): call [`MultiTracker::adopt`] before the next frame, else the hypotheses
+    /// carried are the ones from before.
+    pub fn tracker_mut(&mut self) -> &mut Tracker {
+        &mut self.tracker
+    }
+
+    /// Forgets every hypothesis but the tracker's present memory, which becomes the only one.
+    pub fn adopt(&mut self) {
+        self.hypotheses.clear();
+        let _ = self.hypotheses.push(Hypothesis {
+            memory: self.tracker.memory(),
+            report: FrameReport::default(),
+            score: 0.0,
+            age: 0,
+        });
+    }
+
+    /// New parameters for the frames to come; the hypotheses beyond the new count are dropped.
+    pub fn set_config(&mut self, config: HypothesesConfig) {
+        self.config = config;
+        self.hypotheses.truncate(config.count());
+    }
+
     /// The best state (quaternion, mm, rad).
     pub fn state(&self) -> &[f32] {
         self.tracker.state()

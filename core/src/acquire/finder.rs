@@ -1,0 +1,219 @@
+//! The search and its leaves' judgement in one place, for a status machine to call on every
+//! searching frame: [`Finder::step`] moves the [`Acquirer`] on within its budget; once the
+//! search has ended, it refines [`FinderConfig::leaves_per_frame`] of its leaves per frame by
+//! the tracker's own Gauss–Newton (`Tracker::restart_fresh` then `Tracker::track`) and
+//! [judges](super::accept) each; the best accepted leaf is handed to the tracker, and when
+//! every leaf is refused the search starts over.
+
+use heapless::Vec;
+
+use crate::config::{MAX_CAMERAS, MAX_STATES};
+use crate::frame::FrameView;
+use crate::likelihood::EdgeMap;
+use crate::tracker::{FrameReport, Tracker, TrackerError};
+
+use super::accept::{AcceptConfig, Verdict};
+use super::{Acquirer, Progress, MAX_KEEP};
+
+/// How leaves are refined and judged.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FinderConfig {
+    /// Leaves refined by Gauss–Newton per frame (each costs about one tracking frame).
+    pub leaves_per_frame: u8,
+    /// Leaves refined per search, at most (the best first).
+    pub leaves: u8,
+    /// Times the tracker runs on the frame from each leaf (each up to its iteration limit):
+    /// a leaf farther than one frame's iterations reach converges in the next.
+    pub passes_per_leaf: u8,
+    /// The acceptance thresholds.
+    pub accept: AcceptConfig,
+}
+
+impl Default for FinderConfig {
+    fn default() -> Self {
+        FinderConfig {
+            leaves_per_frame: 2,
+            leaves: 4,
+            passes_per_leaf: 2,
+            accept: AcceptConfig::default(),
+        }
+    }
+}
+
+/// What one searching frame did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FinderStep {
+    /// No hand claimed.
+    Searching {
+        /// Evaluations the search spent on this frame.
+        evaluated: u16,
+        /// Leaves refined on this frame.
+        refined: u8,
+        /// The best judgement of a leaf refined on this frame, if any was.
+        best_leaf: Option<Verdict>,
+    },
+    /// A refined leaf was accepted: the tracker holds it (restarted fresh) and tracks from it
+    /// on the next frame.
+    Found {
+        /// Its judgement.
+        verdict: Verdict,
+        /// The tracker's report of its refinement on this frame.
+        report: FrameReport,
+    },
+}
+
+/// The search, its leaves' refinement and acceptance.
+#[derive(Debug, Clone)]
+pub struct Finder {
+    acquirer: Acquirer,
+    config: FinderConfig,
+    /// Leaves still to refine, the best last (popped first).
+    leaves: Vec<[f32; MAX_STATES], MAX_KEEP>,
+    /// The best leaf refined on the last frame, and its judgement.
+    last: Option<(Verdict, [f32; MAX_STATES])>,
+}
+
+impl Finder {
+    /// A finder around `acquirer`.
+    pub fn new(acquirer: Acquirer, config: FinderConfig) -> Self {
+        Finder {
+            acquirer,
+            config,
+            leaves: Vec::new(),
+            last: None,
+        }
+    }
+
+    /// The search.
+    pub fn acquirer(&self) -> &Acquirer {
+        &self.acquirer
+    }
+
+    /// The parameters.
+    pub fn config(&self) -> &FinderConfig {
+        &self.config
+    }
+
+    /// The search, to place or score hypotheses outside its own steps (the local
+    /// re-acquisition).
+    pub fn acquirer_mut(&mut self) -> &mut Acquirer {
+        &mut self.acquirer
+    }
+
+    /// New acceptance thresholds for the leaves judged from now on.
+    pub fn set_accept(&mut self, accept: AcceptConfig) {
+        self.config.accept = accept;
+    }
+
+    /// The best leaf refined on the last frame (the whole state) and its judgement, if a
+    /// leaf was refined on it.
+    pub fn last_leaf(&self) -> Option<&(Verdict, [f32; MAX_STATES])> {
+        self.last.as_ref()
+    }
+
+    /// Starts over (the hand was lost).
+    pub fn restart(&mut self) {
+        self.acquirer.restart();
+        self.leaves.clear();
+    }
+
+    /// One searching frame: `frames[i]` is camera `i`'s and `edges[i]` its edge map (built
+    /// once for this frame). `tracker` is used to refine leaves; after [`FinderStep::Found`]
+    /// it holds the accepted state, otherwise its state is not to be trusted.
+    pub fn step(
+        &mut self,
+        tracker: &mut Tracker,
+        frames: &[FrameView<'_>],
+        edges: &[EdgeMap<'_>],
+    ) -> Result<FinderStep, TrackerError> {
+        self.last = None;
+        if self.leaves.is_empty() {
+            let progress = self
+                .acquirer
+                .step(tracker.model(), tracker.cameras(), frames, edges);
+            let evaluated = match progress {
+                Progress::Searching { evaluated } => evaluated,
+                Progress::Found(_) => {
+                    let take = usize::from(self.config.leaves.max(1));
+                    for c in self.acquirer.best().iter().take(take).rev() {
+                        // At most MAX_KEEP: cannot overflow.
+                        let _ = self.leaves.push(c.q);
+                    }
+                    0
+                }
+            };
+            // The leaves are refined from the next frame on: this one's budget is spent.
+            return Ok(FinderStep::Searching {
+                evaluated,
+                refined: 0,
+                best_leaf: None,
+            });
+        }
+        let n = tracker.model().n_states().min(MAX_STATES);
+        let mut best: Option<(Verdict, [f32; MAX_STATES], FrameReport)> = None;
+        let mut refined = 0u8;
+        while refined < self.config.leaves_per_frame.max(1) {
+            let Some(leaf) = self.leaves.pop() else {
+                break;
+            };
+            refined += 1;
+            tracker.restart_fresh(&leaf[..n])?;
+            let mut report = tracker.track(frames)?;
+            for _ in 1..self.config.passes_per_leaf.max(1) {
+                if report.lost {
+                    break;
+                }
+                // Again from where it got to, as a fresh start (no velocity from the pass).
+                let mut q = [0.0f32; MAX_STATES];
+                for (d, s) in q.iter_mut().zip(tracker.state()) {
+                    *d = *s;
+                }
+                tracker.restart_fresh(&q[..n])?;
+                report = tracker.track(frames)?;
+            }
+            let mut q = [0.0f32; MAX_STATES];
+            for (d, s) in q.iter_mut().zip(tracker.state()) {
+                *d = *s;
+            }
+            let (score, worst) = if report.lost {
+                (0.0, 0.0)
+            } else {
+                let cameras = tracker.cameras();
+                let n_cameras = cameras.len().min(MAX_CAMERAS);
+                self.acquirer.score_cameras(
+                    tracker.model(),
+                    &cameras[..n_cameras],
+                    frames,
+                    edges,
+                    &q,
+                )
+            };
+            let verdict = self.config.accept.judge(score, worst, report.lost);
+            let better = best
+                .as_ref()
+                .is_none_or(|(b, _, _)| (verdict.accepted, verdict.score) > (b.accepted, b.score));
+            if better {
+                best = Some((verdict, q, report));
+            }
+        }
+        self.last = best.as_ref().map(|(v, q, _)| (*v, *q));
+        match best {
+            Some((verdict, q, report)) if verdict.accepted => {
+                tracker.restart_fresh(&q[..n])?;
+                self.leaves.clear();
+                Ok(FinderStep::Found { verdict, report })
+            }
+            best => {
+                if self.leaves.is_empty() {
+                    self.acquirer.restart();
+                }
+                Ok(FinderStep::Searching {
+                    evaluated: 0,
+                    refined,
+                    best_leaf: best.map(|(v, _, _)| v),
+                })
+            }
+        }
+    }
+}

@@ -1,0 +1,182 @@
+//! How well a hypothesised hand state explains a frame, from the projected model alone (no
+//! stored templates), after Stenger et al.'s tree-based filter: an oriented-edge chamfer term
+//! (how far each projected silhouette line lies from an image edge of like orientation) and a
+//! region term (the silhouette's [agreement](crate::silhouette) with the image).
+//!
+//! The frame's edges are found once per frame into an [`EdgeMap`] — on a grid of
+//! `stride_px` cells, each cell holding, per orientation bin, its distance to the nearest
+//! edge cell of that bin (a two-pass 3-4 chamfer distance transform) — in a buffer the
+//! caller owns ([`EdgeMap::bytes_needed`]). Each hypothesis then costs one projection and a
+//! few table look-ups per link ([`evaluate`]).
+
+use core::fmt;
+
+use crate::camera::Camera;
+use crate::frame::FrameView;
+use crate::nalgebra::Vector2;
+use crate::projection::ProjectedModel;
+
+mod edges;
+mod region;
+mod samples;
+
+pub use edges::{EdgeMap, EDGE_BINS, GRADIENT_STEP_PX};
+pub use region::{Region, EXTENT_PERCENTILE, MAX_EXTENT_BINS, MIN_REGION_SAMPLES};
+pub use samples::{Samples, SilhouettePoint, MAX_SAMPLES, MAX_SAMPLES_PER_LINE};
+
+/// Parameters of the edge map and of the score.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LikelihoodConfig {
+    /// Side of an edge map cell (px, ≥ 1): 4 keeps a VGA frame's map at 115 KB.
+    pub stride_px: u8,
+    /// The weakest edge marked: central-difference gradient magnitude (grey levels over 2 px).
+    pub min_gradient: f32,
+    /// Chamfer distances are truncated here (px), so one missing edge cannot dominate.
+    pub chamfer_cap_px: f32,
+    /// Points sampled along each silhouette line of each link.
+    pub samples_per_line: u8,
+    /// Grid of the silhouette term ([`silhouette::score`](crate::silhouette::score)); 0 leaves
+    /// the term out.
+    pub silhouette_grid: u8,
+    /// Weight of the silhouette term in [`Likelihood::score`] (0..=1); the chamfer term has
+    /// the rest.
+    pub silhouette_weight: f32,
+}
+
+impl Default for LikelihoodConfig {
+    fn default() -> Self {
+        LikelihoodConfig {
+            stride_px: 4,
+            min_gradient: 24.0,
+            chamfer_cap_px: 24.0,
+            samples_per_line: 6,
+            silhouette_grid: 16,
+            silhouette_weight: 0.4,
+        }
+    }
+}
+
+/// Why an edge map could not be built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum LikelihoodError {
+    /// The caller's buffer is smaller than [`EdgeMap::bytes_needed`].
+    BufferTooSmall {
+        /// Bytes needed.
+        needed: u32,
+    },
+    /// `stride_px` is 0.
+    ZeroStride,
+}
+
+impl fmt::Display for LikelihoodError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::BufferTooSmall { needed } => {
+                write!(f, "the edge map needs a buffer of {needed} bytes")
+            }
+            Self::ZeroStride => write!(f, "the edge map's stride must be at least 1 px"),
+        }
+    }
+}
+
+impl core::error::Error for LikelihoodError {}
+
+/// How well one hypothesis explains one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Likelihood {
+    /// Mean truncated distance from the projected silhouette lines to like-oriented image
+    /// edges (px; 0 = every sampled point on an edge).
+    pub chamfer_px: f32,
+    /// Silhouette points sampled inside the frame.
+    pub points: u16,
+    /// Points that fell outside the frame (each costs the cap).
+    pub points_outside: u16,
+    /// Points hidden by a nearer part of the hand (left out).
+    pub points_hidden: u16,
+    /// The silhouette's agreement with the image (0..=1), when it could be scored.
+    pub silhouette: Option<f32>,
+    /// The combined score (0..=1, higher is better): `1 − chamfer/cap` and the silhouette
+    /// agreement, weighted by [`LikelihoodConfig::silhouette_weight`].
+    pub score: f32,
+}
+
+/// Scores the projected model `view` (camera `camera`) against `frame`, whose edges are
+/// `edges`. A view with no link in the frame scores 0.
+#[inline(never)] // a stage of the search: kept whole so profiles can attribute its cost
+pub fn evaluate(
+    view: &ProjectedModel,
+    camera: &Camera,
+    frame: &FrameView<'_>,
+    edges: &EdgeMap<'_>,
+    config: &LikelihoodConfig,
+) -> Likelihood {
+    let samples = Samples::of(view, camera, config);
+    let cap = config.chamfer_cap_px.max(1e-3);
+    let (chamfer_px, inside) = samples.chamfer(edges, Vector2::zeros(), cap);
+    let outside = (samples.points.len() as u16).saturating_sub(inside);
+    if inside == 0 {
+        return Likelihood {
+            chamfer_px: cap,
+            points_outside: outside,
+            points_hidden: samples.hidden,
+            ..Likelihood::default()
+        };
+    }
+    let silhouette = (config.silhouette_grid > 0)
+        .then(|| crate::silhouette::score(view, camera, frame, usize::from(config.silhouette_grid)))
+        .flatten()
+        .map(|s| s.agreement);
+    let w = config.silhouette_weight.clamp(0.0, 1.0);
+    let edge_term = 1.0 - chamfer_px / cap;
+    let score = match silhouette {
+        Some(a) => (1.0 - w) * edge_term + w * a,
+        None => (1.0 - w) * edge_term,
+    };
+    Likelihood {
+        chamfer_px,
+        points: inside,
+        points_outside: outside,
+        points_hidden: samples.hidden,
+        silhouette,
+        score,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_small_buffer_or_a_zero_stride_is_an_error() {
+        let pixels = [0u8; 64 * 48];
+        let frame = FrameView::packed(&pixels, 64, 48).unwrap();
+        let config = LikelihoodConfig::default();
+        let needed = EdgeMap::bytes_needed(64, 48, config.stride_px);
+        assert_eq!(needed, 16 * 12 * EDGE_BINS);
+        let mut small = [0u8; 100];
+        assert_eq!(
+            EdgeMap::build(&mut small, &frame, &config).err(),
+            Some(LikelihoodError::BufferTooSmall {
+                needed: needed as u32
+            })
+        );
+        let mut buffer = [0u8; 16 * 12 * EDGE_BINS];
+        let zero = LikelihoodConfig {
+            stride_px: 0,
+            ..config
+        };
+        assert_eq!(
+            EdgeMap::build(&mut buffer, &frame, &zero).err(),
+            Some(LikelihoodError::ZeroStride)
+        );
+        // A flat frame has no edges: every distance is the farthest.
+        let map = EdgeMap::build(&mut buffer, &frame, &config).unwrap();
+        assert_eq!(map.edge_cells, 0);
+        let far = map.distance_px(0, &Vector2::new(10.0, 10.0)).unwrap();
+        assert!(far > 300.0, "{far}");
+        assert_eq!(map.distance_px(0, &Vector2::new(-1.0, 10.0)), None);
+    }
+}

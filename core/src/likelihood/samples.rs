@@ -1,0 +1,99 @@
+//! The visible silhouette points of a projected hand: what the chamfer term compares with
+//! the frame's edges.
+
+use heapless::Vec;
+
+use crate::camera::Camera;
+use crate::config::MAX_LINKS;
+use crate::nalgebra::Vector2;
+use crate::projection::ProjectedModel;
+use crate::visibility::{candidates, cover_among, Cover};
+
+use super::edges::{bin_of, EdgeMap};
+use super::LikelihoodConfig;
+
+/// Most silhouette points one view yields: two lines per link, at most 16 points each.
+pub const MAX_SAMPLES: usize = MAX_LINKS * 2 * MAX_SAMPLES_PER_LINE;
+
+/// Most points sampled along one silhouette line.
+pub const MAX_SAMPLES_PER_LINE: usize = 16;
+
+/// A visible point of the projected silhouette and the orientation bin of its line's normal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SilhouettePoint {
+    /// Where (px).
+    pub at: Vector2<f32>,
+    /// The orientation bin of the silhouette line's normal.
+    pub bin: u8,
+}
+
+/// The visible silhouette points of a view: what the chamfer term compares with the edges.
+#[derive(Debug, Clone, Default)]
+pub struct Samples {
+    /// Points not hidden by a nearer part of the hand.
+    pub points: Vec<SilhouettePoint, MAX_SAMPLES>,
+    /// Points hidden by a nearer part of the hand (left out).
+    pub hidden: u16,
+}
+
+impl Samples {
+    /// The visible silhouette points of `view` (camera `camera`):
+    /// [`LikelihoodConfig::samples_per_line`] along each side of each link.
+    pub fn of(view: &ProjectedModel, camera: &Camera, config: &LikelihoodConfig) -> Self {
+        let mut out = Samples::default();
+        let n = usize::from(config.samples_per_line).clamp(1, MAX_SAMPLES_PER_LINE);
+        for (index, link) in view.links.iter().enumerate() {
+            let d = link.b - link.a;
+            let len = d.norm();
+            if len < 1e-3 {
+                continue;
+            }
+            let dir = d / len;
+            let normal = Vector2::new(-dir.y, dir.x);
+            let (bin, _) = bin_of(libm::atan2f(normal.y, normal.x));
+            // The parts that can hide any of this link's points, found once for the link (its
+            // bounds hold every silhouette point): the same verdicts as per point, cheaper.
+            let (among, palm) = candidates(view, index, &link.bounds);
+            for (side, sign) in [(0usize, 1.0f32), (1, -1.0)] {
+                for i in 0..n {
+                    let s = (i as f32 + 0.5) / n as f32;
+                    let r = link.r0[side] + s * (link.r1[side] - link.r0[side]);
+                    let p = link.a + d * s + normal * (sign * r);
+                    if cover_among(view, camera, &among, palm, &p, link.depth_at(s))
+                        == Cover::Hidden
+                    {
+                        // A nearer part of the hand hides this line: no edge is expected.
+                        out.hidden = out.hidden.saturating_add(1);
+                        continue;
+                    }
+                    // Bounded by MAX_SAMPLES: cannot overflow.
+                    let _ = out.points.push(SilhouettePoint {
+                        at: p,
+                        bin: bin as u8,
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    /// The mean truncated chamfer distance (px) of the points shifted by `offset` (px) to
+    /// like-oriented edges, and how many fell inside the frame; points outside cost `cap_px`.
+    pub fn chamfer(&self, edges: &EdgeMap<'_>, offset: Vector2<f32>, cap_px: f32) -> (f32, u16) {
+        let (mut sum, mut inside) = (0.0f32, 0u16);
+        for p in &self.points {
+            match edges.distance_px(usize::from(p.bin), &(p.at + offset)) {
+                Some(d) => {
+                    sum += d.min(cap_px);
+                    inside = inside.saturating_add(1);
+                }
+                None => sum += cap_px,
+            }
+        }
+        if self.points.is_empty() {
+            (cap_px, 0)
+        } else {
+            (sum / self.points.len() as f32, inside)
+        }
+    }
+}
