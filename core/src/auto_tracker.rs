@@ -129,6 +129,15 @@ pub struct AutoReport {
     pub best_score: f32,
 }
 
+/// A hypothesis refined on this frame: its state, its mean and worst camera's likelihood
+/// score, and the tracker's report of its last pass.
+struct Refined {
+    score: f32,
+    worst_camera: f32,
+    q: [f32; MAX_STATES],
+    report: FrameReport,
+}
+
 /// A tracker that finds the hand, tracks it, and finds it again.
 #[derive(Debug, Clone)]
 pub struct AutoTracker {
@@ -346,7 +355,7 @@ impl AutoTracker {
         out.local = true;
         let n = self.multi.tracker().model().n_states().min(MAX_STATES);
         let seed = self.held;
-        let mut best: Option<((f32, f32), [f32; MAX_STATES], FrameReport)> = None;
+        let mut best: Option<Refined> = None;
         let followed = self.following.take();
         for c in 0..=maps.len() {
             let tracker = self.multi.tracker();
@@ -361,17 +370,27 @@ impl AutoTracker {
                 _ => followed,
             };
             let Some(start) = start else { continue };
-            let (scores, q, report) = self.refine(frames, maps, start, n)?;
+            let refined = self.refine(frames, maps, start, n)?;
             out.evaluated = out.evaluated.saturating_add(1);
-            if best.as_ref().is_none_or(|(s, _, _)| scores.0 > s.0) {
-                best = Some((scores, q, report));
+            if best.as_ref().is_none_or(|b| refined.score > b.score) {
+                best = Some(refined);
             }
         }
-        let Some(((score, worst), q, report)) = best else {
+        let Some(Refined {
+            score,
+            worst_camera,
+            q,
+            report,
+        }) = best
+        else {
             return Ok(());
         };
         out.leaf_score = Some(score);
-        let verdict = self.finder.config().accept.judge(score, worst, report.lost);
+        let verdict = self
+            .finder
+            .config()
+            .accept
+            .judge(score, worst_camera, report.lost);
         if verdict.accepted {
             self.multi.tracker_mut().restart_fresh(&q[..n])?;
             self.found();
@@ -394,7 +413,7 @@ impl AutoTracker {
         maps: &[EdgeMap<'_>],
         start: [f32; MAX_STATES],
         n: usize,
-    ) -> Result<((f32, f32), [f32; MAX_STATES], FrameReport), AutoError> {
+    ) -> Result<Refined, AutoError> {
         let mut q = start;
         let mut report = FrameReport::default();
         let tracker = self.multi.tracker_mut();
@@ -403,18 +422,28 @@ impl AutoTracker {
             report = tracker.track(frames)?;
             q[..n].copy_from_slice(&tracker.state()[..n]);
             if report.lost {
-                return Ok(((0.0, 0.0), q, report));
+                return Ok(Refined {
+                    score: 0.0,
+                    worst_camera: 0.0,
+                    q,
+                    report,
+                });
             }
         }
         let tracker = self.multi.tracker();
-        let scores = self.finder.acquirer_mut().score_cameras(
+        let (score, worst_camera) = self.finder.acquirer_mut().score_cameras(
             tracker.model(),
             tracker.cameras(),
             frames,
             maps,
             &q,
         );
-        Ok((scores, q, report))
+        Ok(Refined {
+            score,
+            worst_camera,
+            q,
+            report,
+        })
     }
 
     /// A searching frame: the search moves on, or some of its leaves are refined and judged.
