@@ -14,6 +14,7 @@ use digiteyes_host::report::{build_report, ReportOptions};
 use digiteyes_host::scenarios::{render_scenario, RenderOptions};
 use digiteyes_host::sequence::hypotheses::{parse_hypotheses, read_hypotheses};
 use digiteyes_host::sequence::states::read_states;
+use digiteyes_host::sequence::status::Status;
 use digiteyes_host::track::{track_sequence_to, Init, TrackOptions, TrackOutputs};
 use digiteyes_host::ui::{RunningUi, UiOptions, UiSource};
 use digiteyes_host::TrackerConfig;
@@ -135,7 +136,7 @@ fn k4_writes_every_hypothesis_carried_and_the_best_is_the_output() {
         // One row per hypothesis carried, as the tracker reported the count.
         assert_eq!(rows.len(), usize::from(carried[k]), "frame {k}");
         assert!(rows.len() <= 4, "frame {k}: {} rows", rows.len());
-        let searching = statuses[k] == Some(digiteyes_host::sequence::status::Status::Searching);
+        let searching = statuses[k] == Some(Status::Searching);
         assert_eq!(rows.is_empty(), searching, "frame {k}");
         if let Some(best) = rows.first() {
             // Rank 0 is the output.
@@ -190,6 +191,46 @@ fn k4_writes_every_hypothesis_carried_and_the_best_is_the_output() {
     assert!(with.contains(r#"class="hypotheses-plot" data-series="best-score""#));
     assert!(with.contains("<h2>Hypotheses</h2>"));
     assert!(with.contains(r#"<polyline class="hyp-count""#));
+}
+
+#[test]
+fn searching_frames_carry_no_hypotheses() {
+    let dir = tempfile::tempdir().unwrap();
+    render(dir.path(), "fullhand-mono", 12, (240, 180));
+    let out = digiteyes(
+        &[
+            "track",
+            "seq",
+            "-q",
+            "--init",
+            "auto",
+            "--hypotheses",
+            "2",
+            "--hypotheses-out",
+            "hyp.csv",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let states = read_states(&dir.path().join("states.csv"), 28).unwrap();
+    let table = read_hypotheses(&dir.path().join("hyp.csv"), 28).unwrap();
+    let by_frame = table.by_frame(states.rows.len());
+    let statuses = states.status.unwrap();
+    let searching = |k: usize| statuses[k] == Some(Status::Searching);
+    assert!(
+        (0..statuses.len()).any(searching),
+        "no searching frame to judge: {statuses:?}"
+    );
+    for (k, rows) in by_frame.iter().enumerate() {
+        assert_eq!(
+            rows.is_empty(),
+            searching(k),
+            "frame {k}: {} rows",
+            rows.len()
+        );
+        assert!(rows.len() <= 2);
+    }
+    assert!(text(&out.stdout).contains("hypotheses: up to 2"));
 }
 
 /// `GET path` on the UI; the body.

@@ -312,7 +312,10 @@ fn a_replay_with_hypotheses_draws_the_others_ghosted_behind_the_hand() {
     assert_eq!(body_data(&dom, "hand"), "solid", "{dom}");
     assert_eq!(body_data(&dom, "shapes-drawn"), "16");
     assert_eq!(body_data(&dom, "ghosts-drawn"), "1", "{dom}");
-    assert!(dom.contains(" · 2 hypotheses (best scores 0.900)"), "{dom}");
+    assert!(
+        dom.contains(" · 2 hypotheses, the best scoring 0.900"),
+        "{dom}"
+    );
     let dom = replay_page(&exe, false);
     assert_eq!(body_data(&dom, "hand"), "solid", "{dom}");
     assert_eq!(body_data(&dom, "ghosts-drawn"), "0", "{dom}");

@@ -496,7 +496,7 @@ function updatePanels() {
     ? `frame ${s.frame} · ${word} · rms ${Number.isFinite(s.rms_px) ? s.rms_px.toFixed(2) : "–"} px · ` +
       `${s.features_found}/${s.features_expected} features · ${s.iterations} iterations` +
       (snap.hypotheses > 1
-        ? ` · ${snap.hypotheses} hypotheses (best scores ${Number(snap.best_score).toFixed(3)})`
+        ? ` · ${snap.hypotheses} hypotheses, the best scoring ${Number(snap.best_score).toFixed(3)}`
         : "")
     : "no state yet";
   document.body.dataset.frame = s ? String(s.frame) : "";
