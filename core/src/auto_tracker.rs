@@ -127,6 +127,9 @@ pub struct AutoReport {
     /// The best hypothesis' likelihood score on a tracking frame with several hypotheses
     /// (0 otherwise).
     pub best_score: f32,
+    /// The best hypothesis is not the previous frame's best (a tracking frame with several
+    /// hypotheses whose ranking changed; false otherwise).
+    pub switched: bool,
 }
 
 /// A hypothesis refined on this frame: its state, its mean and worst camera's likelihood
@@ -320,6 +323,7 @@ impl AutoTracker {
             local: false,
             hypotheses: multi.count,
             best_score: multi.score,
+            switched: multi.switched,
         })
     }
 

@@ -205,6 +205,7 @@ pub fn serve_demo_ui(dir: &Path, duration: Option<Duration>, out: &mut dyn Write
         source: UiSource::Replay {
             seqdir: dir.to_path_buf(),
             states: dir.join("states.csv"),
+            hypotheses: None,
             camera: 0,
             fps: None,
         },

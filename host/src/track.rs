@@ -11,6 +11,10 @@
 //! states are the last tracked ones (the search's base state before the first acquisition).
 //! Optionally each frame of each camera is also drawn with the model, the slices searched and
 //! the features found at the state tracked for it ([`crate::overlay`]), as PNGs.
+//!
+//! With [`TrackOptions::hypotheses`] asking for K > 1, the tracker carries up to K hypotheses
+//! ([`digiteyes_core::hypotheses`]); the best is the output. [`TrackOutputs::hypotheses_out`]
+//! writes every one carried, frame by frame ([`crate::sequence::hypotheses`]).
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -18,11 +22,14 @@ use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Context, Result};
 use digiteyes_core::acquire::AcquireConfig;
+use digiteyes_core::config::MAX_HYPOTHESES;
 use digiteyes_core::frame::FrameView;
+use digiteyes_core::hypotheses::HypothesesConfig;
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
 
 use crate::acquire::{AutoTracker, Recovery, Status};
 use crate::overlay::{draw_overlay, overlay_path, PngStats, PngWriter};
+use crate::sequence::hypotheses::HypothesesWriter;
 pub use crate::sequence::status::{StatusCounts, STATUS_COLUMN};
 use crate::sequence::{Sequence, StatesWriter};
 
@@ -57,6 +64,10 @@ pub struct TrackOptions {
     pub recovery: Recovery,
     /// The search's parameters.
     pub acquire: AcquireConfig,
+    /// The hypotheses carried (`count` 1, the default: the single tracker, bit for bit).
+    /// Their likelihood's edge-map stride is taken from [`TrackOptions::acquire`], whose
+    /// buffers they share.
+    pub hypotheses: HypothesesConfig,
 }
 
 impl Default for TrackOptions {
@@ -65,7 +76,44 @@ impl Default for TrackOptions {
             init: None,
             recovery: Recovery::Search,
             acquire: AcquireConfig::default(),
+            hypotheses: HypothesesConfig::default(),
         }
+    }
+}
+
+/// The files a tracking run writes besides the states CSV.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TrackOutputs<'a> {
+    /// Each frame of each camera drawn at its tracked state into `DIR/camN/NNNNNN.png`.
+    pub overlay_dir: Option<&'a Path>,
+    /// Every hypothesis carried, one row per hypothesis per frame
+    /// ([`crate::sequence::hypotheses`]).
+    pub hypotheses_out: Option<&'a Path>,
+}
+
+/// What the hypotheses did over a run.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct HypothesesSummary {
+    /// Hypotheses asked for (K).
+    pub asked: usize,
+    /// Hypotheses carried after each frame (0 on a searching frame).
+    pub carried: Vec<u8>,
+    /// Frames on which the best was not the previous frame's best.
+    pub switches: usize,
+    /// Where the hypotheses were written, and the rows written.
+    pub out: Option<(PathBuf, usize)>,
+}
+
+impl HypothesesSummary {
+    /// Frames with hypotheses (not searching).
+    pub fn frames_with(&self) -> usize {
+        self.carried.iter().filter(|&&c| c > 0).count()
+    }
+
+    /// The mean count carried over the frames with hypotheses (0 when none had any).
+    pub fn mean_carried(&self) -> f64 {
+        let sum: usize = self.carried.iter().map(|&c| usize::from(c)).sum();
+        sum as f64 / self.frames_with().max(1) as f64
     }
 }
 
@@ -94,6 +142,8 @@ pub struct TrackSummary {
     pub fps: Option<f64>,
     /// The overlay PNGs written, when asked for: where, and the writer's figures.
     pub overlays: Option<(PathBuf, PngStats)>,
+    /// The hypotheses carried and how often the best changed.
+    pub hypotheses: HypothesesSummary,
 }
 
 impl TrackSummary {
@@ -130,7 +180,27 @@ impl fmt::Display for TrackSummary {
             )?,
             _ => writeln!(f)?,
         }
+        let h = &self.hypotheses;
+        if h.asked > 1 {
+            writeln!(
+                f,
+                "hypotheses: up to {}, {:.2} carried on average over {} frame(s) not searching; \
+                 the best switched on {} frame(s) ({:.1} %)",
+                h.asked,
+                h.mean_carried(),
+                h.frames_with(),
+                h.switches,
+                100.0 * h.switches as f64 / h.frames_with().max(1) as f64
+            )?;
+        }
         write!(f, "states written to {}", self.out.display())?;
+        if let Some((path, rows)) = &h.out {
+            write!(
+                f,
+                "\nhypotheses: {rows} row(s) written to {}",
+                path.display()
+            )?;
+        }
         if let Some((dir, png)) = &self.overlays {
             write!(
                 f,
@@ -228,7 +298,28 @@ pub fn sequence_auto_tracker(
     }
     .with_context(|| format!("{name}"))?;
     auto.set_recovery(options.recovery);
+    auto.set_hypotheses(hypotheses_config(options)?);
     Ok(auto)
+}
+
+/// The hypotheses' parameters `options` ask for, their edge-map stride the search's (the
+/// buffers are shared). Fails, naming `--hypotheses`, on a count outside 1..=[`MAX_HYPOTHESES`].
+pub fn hypotheses_config(options: &TrackOptions) -> Result<HypothesesConfig> {
+    let mut config = options.hypotheses;
+    check_hypotheses_count(usize::from(config.count))?;
+    config.likelihood.stride_px = options.acquire.likelihood.stride_px;
+    Ok(config)
+}
+
+/// Checks a count of hypotheses: 1..=[`MAX_HYPOTHESES`], else an error naming
+/// `--hypotheses` and the range.
+pub fn check_hypotheses_count(count: usize) -> Result<()> {
+    if !(1..=MAX_HYPOTHESES).contains(&count) {
+        bail!(
+            "--hypotheses {count}: the count must be 1 to {MAX_HYPOTHESES} (1: the single tracker)"
+        );
+    }
+    Ok(())
 }
 
 /// [`track_sequence_with`] as `options` ask: how to start and whether to search again after
@@ -241,6 +332,24 @@ pub fn track_sequence_opts(
     overlay_dir: Option<&Path>,
     options: &TrackOptions,
 ) -> Result<TrackSummary> {
+    let outputs = TrackOutputs {
+        overlay_dir,
+        ..TrackOutputs::default()
+    };
+    track_sequence_to(seq, out_csv, config, progress, &outputs, options)
+}
+
+/// [`track_sequence_opts`] writing every file `outputs` asks for; each output appears whole
+/// or not at all.
+pub fn track_sequence_to(
+    seq: &Path,
+    out_csv: &Path,
+    config: TrackerConfig,
+    progress: bool,
+    outputs: &TrackOutputs<'_>,
+    options: &TrackOptions,
+) -> Result<TrackSummary> {
+    let overlay_dir = outputs.overlay_dir;
     let start = Instant::now();
     let sequence = Sequence::open(seq)?;
     sequence.check_frames()?;
@@ -249,6 +358,14 @@ pub fn track_sequence_opts(
     let mut tracker = sequence_auto_tracker(&sequence, config, options)?;
     let mut writer = StatesWriter::with_columns(out_csv, sequence.n_states(), &[STATUS_COLUMN])?;
     let mut overlays = overlay_dir.map(|_| PngWriter::start(8)).transpose()?;
+    let mut hypotheses_out = outputs
+        .hypotheses_out
+        .map(|path| HypothesesWriter::create(path, sequence.n_states()))
+        .transpose()?;
+    let mut hypotheses = HypothesesSummary {
+        asked: usize::from(options.hypotheses.count),
+        ..HypothesesSummary::default()
+    };
     let bar = crate::progress::bar(sequence.frames, "track", progress);
     let mut tracking = Duration::ZERO;
     let (mut lost, mut rms_sum, mut rms_frames) = (0, 0.0, 0);
@@ -281,6 +398,18 @@ pub fn track_sequence_opts(
         writer
             .write_with(tracker.state(), &report, &[auto.status.as_str()])
             .with_context(|| format!("frame {k}"))?;
+        let carried = match auto.status {
+            Status::Searching => &[][..],
+            Status::Tracking | Status::Lost => tracker.inner().hypotheses(),
+        };
+        if let Some(out) = hypotheses_out.as_mut() {
+            out.write_frame(k, carried)?;
+        }
+        hypotheses.carried.push(match auto.status {
+            Status::Searching => 0,
+            Status::Tracking | Status::Lost => auto.hypotheses,
+        });
+        hypotheses.switches += usize::from(auto.switched);
         if let (Some(dir), Some(writer)) = (overlay_dir, overlays.as_mut()) {
             for (c, image) in images.iter().enumerate() {
                 let drawn = draw_overlay(
@@ -304,6 +433,9 @@ pub fn track_sequence_opts(
     }
     bar.finish_and_clear();
     let frames = writer.finish()?;
+    if let (Some(path), Some(out)) = (outputs.hypotheses_out, hypotheses_out) {
+        hypotheses.out = Some((path.to_path_buf(), out.finish()?));
+    }
     let overlays = match (overlay_dir, overlays) {
         (Some(dir), Some(writer)) => Some((dir.to_path_buf(), writer.finish()?)),
         _ => None,
@@ -320,5 +452,6 @@ pub fn track_sequence_opts(
         out: out_csv.to_path_buf(),
         fps: sequence.fps(),
         overlays,
+        hypotheses,
     })
 }

@@ -236,6 +236,7 @@ fn a_replay_shows_the_camera_frame_with_the_model() {
     let ui = start_ui(UiSource::Replay {
         seqdir: seq.clone(),
         states,
+        hypotheses: None,
         camera: 0,
         fps: Some(20.0),
     });

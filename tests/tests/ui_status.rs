@@ -237,6 +237,7 @@ fn a_replayed_csv_with_a_status_column_shows_it() {
             source: UiSource::Replay {
                 seqdir: seq.clone(),
                 states,
+                hypotheses: None,
                 camera: 0,
                 fps: Some(20.0),
             },
@@ -251,4 +252,71 @@ fn a_replayed_csv_with_a_status_column_shows_it() {
     assert_eq!(shown, Some("searching"), "the replay's states");
     assert_eq!(badge(&dom), "SEARCHING", "{dom}");
     assert_eq!(body_data(&dom, "hand"), "hidden");
+}
+
+/// The DOM of a replay of a tracked 4-frame mouse sequence at 160×120, with a hypotheses CSV
+/// holding, for every frame, the output and one other (finger 1's MCP bent 0.5 rad further)
+/// when `with_hypotheses`.
+fn replay_page(exe: &Path, with_hypotheses: bool) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("mouse");
+    let render = RenderOptions {
+        frames: Some(4),
+        size: Some((160, 120)),
+        supersample: 1,
+        ..RenderOptions::default()
+    };
+    render_scenario("mouse", &seq, &render).unwrap();
+    let states = seq.join("states.csv");
+    track_sequence(&seq, &states, TrackerConfig::default(), false).unwrap();
+    let table = digiteyes_host::sequence::states::read_states(&states, 28).unwrap();
+    let mut csv = digiteyes_host::sequence::hypotheses::hypotheses_header(28);
+    csv.push('\n');
+    for (k, row) in table.rows.iter().enumerate() {
+        for (rank, bend) in [(0, 0.0), (1, 0.5)] {
+            csv.push_str(&format!("{k},{rank},0.9,{k}"));
+            for (i, v) in row.iter().enumerate() {
+                csv.push_str(&format!(",{}", if i == 8 { v + bend } else { *v }));
+            }
+            csv.push('\n');
+        }
+    }
+    let hypotheses = seq.join("hypotheses.csv");
+    std::fs::write(&hypotheses, csv).unwrap();
+    let ui = RunningUi::start(
+        &UiOptions {
+            bind: "127.0.0.1:0".parse().unwrap(),
+            source: UiSource::Replay {
+                seqdir: seq.clone(),
+                states,
+                hypotheses: with_hypotheses.then_some(hypotheses),
+                camera: 0,
+                fps: Some(20.0),
+            },
+            duration: None,
+        },
+        &mut std::io::sink(),
+    )
+    .expect("the UI starts");
+    let dom = common::browser::dump_dom(exe, &ui.url(), PAGE_BUDGET_MS);
+    ui.stop().unwrap();
+    dom
+}
+
+#[test]
+fn a_replay_with_hypotheses_draws_the_others_ghosted_behind_the_hand() {
+    let Some(exe) = chromium_or_skip("replay hypotheses") else {
+        return;
+    };
+    let dom = replay_page(&exe, true);
+    assert_eq!(body_data(&dom, "hand"), "solid", "{dom}");
+    assert_eq!(body_data(&dom, "shapes-drawn"), "16");
+    assert_eq!(body_data(&dom, "ghosts-drawn"), "1", "{dom}");
+    assert!(
+        dom.contains(" · 2 hypotheses, the best scoring 0.900"),
+        "{dom}"
+    );
+    let dom = replay_page(&exe, false);
+    assert_eq!(body_data(&dom, "hand"), "solid", "{dom}");
+    assert_eq!(body_data(&dom, "ghosts-drawn"), "0", "{dom}");
 }

@@ -17,7 +17,8 @@ use crate::report::{write_report, ReportOptions};
 /// residual); one plot per free state against time (s; frames without fps) in the
 /// state's unit (mm, rad), estimate and truth, with the frames flagged lost shaded and
 /// the frames a board dropped (the `dropped` column of `stream`) marked; and the model
-/// drawn over every Nth frame (--thumb-every). States that are not numbers are gaps in
+/// drawn over every Nth frame (--thumb-every); with --hypotheses FILE (`track
+/// --hypotheses-out`), the hypotheses carried and the best's score against time. States that are not numbers are gaps in
 /// the plots and a warning, not an error. Prints the path written and a summary.
 #[derive(Args, Debug)]
 pub struct ReportArgs {
@@ -40,6 +41,10 @@ pub struct ReportArgs {
     /// Thumbnails of this camera only (0-based; default: every camera).
     #[arg(long, value_name = "N")]
     pub camera_index: Option<usize>,
+    /// Also plot the hypotheses carried and the best's score against time, from this CSV
+    /// (`track --hypotheses-out`).
+    #[arg(long, value_name = "FILE")]
+    pub hypotheses: Option<PathBuf>,
 }
 
 /// Writes the report; prints its warnings on stderr and the summary.
@@ -48,6 +53,7 @@ pub fn run(args: ReportArgs) -> Result<()> {
         thumb_every: args.thumb_every,
         thumb_width: args.thumb_width,
         camera: args.camera_index,
+        hypotheses: args.hypotheses,
         ..ReportOptions::default()
     };
     let summary = write_report(&args.seqdir, &args.states, &args.out, &options)?;

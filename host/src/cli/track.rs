@@ -7,7 +7,8 @@ use clap::{Args, ValueEnum};
 
 use super::tracker_config;
 use crate::acquire::Recovery;
-use crate::track::{track_sequence_opts, Init, TrackOptions};
+use crate::track::{track_sequence_to, Init, TrackOptions, TrackOutputs};
+use digiteyes_core::hypotheses::HypothesesConfig;
 
 /// Track a sequence and write the estimated states as CSV.
 ///
@@ -34,6 +35,13 @@ use crate::track::{track_sequence_opts, Init, TrackOptions};
 /// each link's axis (orange) and silhouette lines (cyan), the slices searched (blue;
 /// purple where masked as hidden), the edge points found (red squares) and the
 /// fingertips found (green crosses). See docs/overlay.md.
+///
+/// With --hypotheses K (1 to 8; 1, the default, is the single tracker, bit for bit) the
+/// tracker carries up to K hypotheses through ambiguous frames and outputs the best; the
+/// summary then says how many were carried on average and how often the best switched.
+/// --hypotheses-out FILE writes every hypothesis carried: one row per hypothesis per frame,
+/// `frame,rank,score,age,q0..` (rank 0 is the best, the output; a searching frame has no
+/// row). See docs/hypotheses.md.
 #[derive(Args, Debug)]
 pub struct TrackArgs {
     /// Sequence folder.
@@ -61,6 +69,22 @@ pub struct TrackArgs {
     /// view), or `never` (stay lost, as the plain tracker did).
     #[arg(long, value_enum, value_name = "HOW", default_value = "search")]
     pub recover: RecoverArg,
+    /// Hypotheses carried through ambiguous frames, 1 to 8 (1: the single tracker).
+    #[arg(long, value_name = "K", default_value_t = 1, value_parser = hypotheses_count)]
+    pub hypotheses: u8,
+    /// Also write every hypothesis carried, one row per hypothesis per frame, to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub hypotheses_out: Option<PathBuf>,
+}
+
+/// `--hypotheses`' values: a whole number 1..=MAX_HYPOTHESES.
+fn hypotheses_count(text: &str) -> Result<u8, String> {
+    let max = digiteyes_core::config::MAX_HYPOTHESES;
+    let range = format!("a whole number from 1 to {max} (1: the single tracker)");
+    match text.trim().parse::<usize>() {
+        Ok(k) if (1..=max).contains(&k) => u8::try_from(k).map_err(|_| range),
+        _ => Err(format!("{} is not {range}", crate::text::quote_value(text))),
+    }
 }
 
 /// `--init`'s values.
@@ -93,14 +117,22 @@ pub fn run(args: TrackArgs, progress: bool) -> Result<()> {
             RecoverArg::Search => Recovery::Search,
             RecoverArg::Never => Recovery::Never,
         },
+        hypotheses: HypothesesConfig {
+            count: args.hypotheses,
+            ..HypothesesConfig::default()
+        },
         ..TrackOptions::default()
     };
-    let summary = track_sequence_opts(
+    let outputs = TrackOutputs {
+        overlay_dir: args.overlay.as_deref(),
+        hypotheses_out: args.hypotheses_out.as_deref(),
+    };
+    let summary = track_sequence_to(
         &args.seqdir,
         &args.out,
         config,
         progress && !args.quiet,
-        args.overlay.as_deref(),
+        &outputs,
         &options,
     )?;
     println!("{summary}");

@@ -18,7 +18,8 @@ use crate::ui::{run_ui, UiOptions, UiSource, DEFAULT_BIND};
 ///   --udp ADDR:PORT   JSON lines of board messages, as `listen --forward udp://` sends
 ///   --replay SEQDIR   a tracked sequence played back at its frame rate, with its frames
 ///                     and the model drawn over them (states from --states, default
-///                     SEQDIR/states.csv)
+///                     SEQDIR/states.csv; --hypotheses CSV draws the other
+///                     hypotheses of `track --hypotheses-out` ghosted behind the hand)
 /// The page shows the 3D hand at the newest state (drag to orbit, wheel to zoom), the
 /// camera frame with the back-projected model when the source has frames, the 3D mouse
 /// (thesis Sec. 4.3.4: the pole's base follows the palm on the table, its height finger
@@ -48,6 +49,10 @@ pub struct UiArgs {
     /// With --replay: the states to show (default SEQDIR/states.csv).
     #[arg(long, value_name = "CSV", requires = "replay")]
     pub states: Option<PathBuf>,
+    /// With --replay: the hypotheses tracked (`track --hypotheses-out`); the others than the
+    /// best are drawn ghosted behind the hand.
+    #[arg(long, value_name = "CSV", requires = "replay")]
+    pub hypotheses: Option<PathBuf>,
     /// With --replay: frames/s, 0.01 to 1000 (default: the sequence's, else 15).
     #[arg(long, value_name = "FPS", requires = "replay", value_parser = cli_values::fps)]
     pub fps: Option<f64>,
@@ -75,6 +80,7 @@ pub fn run(args: UiArgs) -> Result<()> {
         (None, Some(addr), None) => UiSource::Udp(addr),
         (None, None, Some(seqdir)) => UiSource::Replay {
             states: args.states.unwrap_or_else(|| seqdir.join("states.csv")),
+            hypotheses: args.hypotheses,
             seqdir,
             camera: args.camera_index.unwrap_or(0),
             fps: args.fps,

@@ -34,13 +34,14 @@ svg .grid line{stroke:#eee}svg .frame{fill:none;stroke:#999}
 svg .xtick line,svg .ytick line{stroke:#999}
 polyline{fill:none;stroke-width:1.4;stroke-linejoin:round}
 .estimate{stroke:#1f5fbf}.truth{stroke:#d9480f;stroke-dasharray:4 2}
-.rms{stroke:#5c940d}.joint{stroke:#862e9c}
+.rms{stroke:#5c940d}.joint{stroke:#862e9c}.hyp-count{stroke:#0b7285}.hyp-score{stroke:#5f3dc4}
 rect.lost{fill:#adb5bd;fill-opacity:.35}
 .dropped line{stroke:#c92a2a;stroke-width:.8;stroke-dasharray:2 2}.dropped path{fill:#c92a2a}
 .gap line{stroke:#f08c00;stroke-width:.8}.gap path{fill:#f08c00}
 .threshold line{stroke:#c92a2a;stroke-dasharray:6 3}.threshold text{fill:#c92a2a;font-size:10px}
 .key.estimate,.key.truth,.key.rms,.key.joint{stroke:none}
 .key.estimate{fill:#1f5fbf}.key.truth{fill:#d9480f}.key.rms{fill:#5c940d}.key.joint{fill:#862e9c}
+.key.hyp-count{stroke:none;fill:#0b7285}.key.hyp-score{stroke:none;fill:#5f3dc4}
 .key.lost{fill:#adb5bd}.key.dropped{fill:#c92a2a}.key.gap{fill:#f08c00}
 .status-searching{fill:#4dabf7}.status-tracking{fill:#40c057}.status-lost{fill:#f59f00}
 .thumbs{display:flex;flex-wrap:wrap;gap:10px}

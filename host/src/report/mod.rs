@@ -13,6 +13,7 @@
 
 pub mod accuracy;
 pub mod html;
+pub mod hypotheses;
 pub mod input;
 pub mod mouse;
 pub mod plots;
@@ -51,6 +52,8 @@ pub struct ReportOptions {
     pub camera: Option<usize>,
     /// The feature search the overlay draws (the tracker's default).
     pub features: FeatureConfig,
+    /// `track --hypotheses-out`'s CSV: its count and best score plotted against time.
+    pub hypotheses: Option<PathBuf>,
 }
 
 impl Default for ReportOptions {
@@ -60,6 +63,7 @@ impl Default for ReportOptions {
             thumb_width: DEFAULT_THUMB_WIDTH,
             camera: None,
             features: FeatureConfig::default(),
+            hypotheses: None,
         }
     }
 }
@@ -82,6 +86,8 @@ pub struct ReportSummary {
     /// The 3D mouse read off the estimate against the truth's, for a 3D-mouse sub-model with a
     /// truth.
     pub mouse: Option<MouseAccuracy>,
+    /// Hypotheses plots (count and best score), with `--hypotheses`.
+    pub hypotheses_plots: usize,
     /// Overlay thumbnails.
     pub thumbnails: usize,
     /// Size of the page (bytes).
@@ -112,6 +118,9 @@ impl fmt::Display for ReportSummary {
             self.error_plots,
             self.thumbnails
         )?;
+        if self.hypotheses_plots > 0 {
+            write!(f, ", {} hypotheses plots", self.hypotheses_plots)?;
+        }
         match &self.eval {
             Some(e) => {
                 let tips = e.fingertip_mean_by_frame.iter().sum::<f64>()
@@ -174,6 +183,11 @@ pub fn build_report(
         Some(truth) => accuracy(&inputs, truth)?,
         None => None,
     };
+    let hypotheses = options
+        .hypotheses
+        .as_deref()
+        .map(|path| hypotheses::HypothesesSeries::read(&inputs, path))
+        .transpose()?;
     let warnings = warnings(&inputs, accuracy.as_ref());
     let free = inputs.sequence.free_states();
     let mut page = Page::new();
@@ -193,6 +207,16 @@ pub fn build_report(
     page.heading("Error over time");
     let error_plots = plots::error_plots(&inputs, accuracy.as_ref());
     page.raw(&grid(&error_plots));
+    let hypotheses_plots = match &hypotheses {
+        Some(series) => {
+            page.heading("Hypotheses");
+            page.paragraph(&series.summary());
+            let plots = series.plots(&inputs);
+            page.raw(&grid(&plots));
+            plots.len()
+        }
+        None => 0,
+    };
     let mouse = mouse::mouse_section(&inputs)?;
     if let Some(section) = &mouse {
         page.heading("3D mouse (the thesis' Fig. 4.12)");
@@ -234,6 +258,7 @@ pub fn build_report(
         error_plots: error_plots.len(),
         mouse_plots: mouse.as_ref().map_or(0, |m| m.plots.len()),
         mouse: mouse.and_then(|m| m.accuracy),
+        hypotheses_plots,
         thumbnails: thumbs.len(),
         bytes: html.len(),
         lost_frames: inputs.lost.iter().filter(|&&l| l).count(),

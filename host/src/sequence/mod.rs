@@ -9,6 +9,7 @@
 //! [`Sequence::open`] reads and checks everything but the pixels; frames are read one at a
 //! time with [`Sequence::read_frame`]. Every error names the file and says what is wrong.
 
+pub mod hypotheses;
 pub mod json;
 pub mod pgm;
 pub mod states;

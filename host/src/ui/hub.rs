@@ -61,6 +61,35 @@ impl From<&digiteyes_core::protocol::State> for ShownState {
     }
 }
 
+/// One of the hypotheses a tracker carried after a frame, as the UI shows it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ShownHypothesis {
+    /// Its place among the frame's hypotheses (0: the best, the state shown).
+    pub rank: u8,
+    /// Its likelihood score less the lost penalty (0 with a single hypothesis).
+    pub score: f32,
+    /// Frames it has been carried.
+    pub age: u32,
+    /// Its state (quaternion, mm, rad).
+    pub q: Vec<f32>,
+}
+
+/// A hypothesis other than the best, drawn ghosted behind the hand.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Ghost {
+    /// Its place among the frame's hypotheses (1 and up).
+    pub rank: u8,
+    /// Its likelihood score less the lost penalty.
+    pub score: f32,
+    /// Frames it has been carried.
+    pub age: u32,
+    /// Its state (quaternion, mm, rad).
+    pub q: Vec<f32>,
+    /// The hand's solid shapes at that state (world, mm); empty when the state does not fit
+    /// the model.
+    pub shapes: Vec<WorldShape>,
+}
+
 /// A status as its word in the page's JSON (`Status::as_str`).
 fn status_word<S: serde::Serializer>(status: &Status, serializer: S) -> Result<S::Ok, S::Error> {
     serializer.serialize_str(status.as_str())
@@ -134,6 +163,14 @@ pub struct Snapshot {
     pub link: LinkFigures,
     /// Number of the newest camera frame (fetch `/frame.png`), if frames are available.
     pub camera_frame: Option<u32>,
+    /// Hypotheses the tracker carried after the shown state's frame, when the source tells
+    /// (0: not told, or searching).
+    pub hypotheses: u8,
+    /// The best hypothesis' score on that frame, when the source tells.
+    pub best_score: Option<f32>,
+    /// The other hypotheses of that frame (rank 1 and up), drawn ghosted behind the hand; none
+    /// while searching.
+    pub ghosts: Vec<Ghost>,
 }
 
 /// Turns a state into the 3D-mouse reading the page shows; see [`Hub::set_mouse`].
@@ -149,6 +186,20 @@ struct Inner {
     link: LinkFigures,
     frame: Option<CameraFrame>,
     info: ModelInfo,
+    /// The hypotheses of the last few frames told (newest last), at most
+    /// [`HYPOTHESES_FRAMES_KEPT`]: a frame's state may arrive before or after them.
+    hypotheses: VecDeque<FrameHypotheses>,
+}
+
+/// Frames whose hypotheses are kept waiting for (or showing with) their state.
+pub const HYPOTHESES_FRAMES_KEPT: usize = 4;
+
+/// The hypotheses a source told of one frame.
+struct FrameHypotheses {
+    frame: u32,
+    count: u8,
+    best_score: Option<f32>,
+    ghosts: Vec<Ghost>,
 }
 
 /// The shared picture; clone the `Arc` to hand it to a source or the server.
@@ -174,6 +225,7 @@ impl Hub {
                 arrivals: VecDeque::new(),
                 link: LinkFigures::default(),
                 frame: None,
+                hypotheses: VecDeque::new(),
                 info: ModelInfo {
                     source: source.into(),
                     labels,
@@ -244,6 +296,36 @@ impl Hub {
             inner.arrivals.pop_front();
         }
         inner.state = Some((state, now));
+        inner.seq += 1;
+    }
+
+    /// Takes in the hypotheses carried after frame `frame`, best first (none: the tracker
+    /// carried none, e.g. searching). They are shown with the state of the same frame,
+    /// whether it comes before or after them; the best is that state, the others are ghosts.
+    pub fn push_hypotheses(&self, frame: u32, hypotheses: &[ShownHypothesis]) {
+        let ghosts = hypotheses
+            .iter()
+            .filter(|h| h.rank > 0)
+            .map(|h| Ghost {
+                rank: h.rank,
+                score: h.score,
+                age: h.age,
+                q: h.q.clone(),
+                shapes: world_shapes(&self.model, &h.q).unwrap_or_default(),
+            })
+            .collect();
+        let best_score = hypotheses.iter().find(|h| h.rank == 0).map(|h| h.score);
+        let mut inner = self.lock();
+        inner.hypotheses.retain(|h| h.frame != frame);
+        if inner.hypotheses.len() >= HYPOTHESES_FRAMES_KEPT {
+            inner.hypotheses.pop_front();
+        }
+        inner.hypotheses.push_back(FrameHypotheses {
+            frame,
+            count: hypotheses.len().min(usize::from(u8::MAX)) as u8,
+            best_score,
+            ghosts,
+        });
         inner.seq += 1;
     }
 
@@ -325,6 +407,15 @@ impl Hub {
             .count();
         let mut link = inner.link.clone();
         link.states_per_s = recent as f64 / RATE_WINDOW.as_secs_f64();
+        // The hypotheses of the shown state's frame only, and none while searching.
+        let hypotheses = match &inner.state {
+            Some((state, _)) if state.status != Status::Searching => inner
+                .hypotheses
+                .iter()
+                .rev()
+                .find(|h| h.frame == state.frame),
+            _ => None,
+        };
         Snapshot {
             seq: inner.seq,
             state: inner.state.as_ref().map(|(s, _)| s.clone()),
@@ -334,6 +425,9 @@ impl Hub {
             mouse: inner.mouse.clone(),
             link,
             camera_frame: inner.frame.as_ref().map(|f| f.frame),
+            hypotheses: hypotheses.map_or(0, |h| h.count),
+            best_score: hypotheses.and_then(|h| h.best_score),
+            ghosts: hypotheses.map_or_else(Vec::new, |h| h.ghosts.clone()),
         }
     }
 }
@@ -410,6 +504,62 @@ mod tests {
         assert!(s.shapes.is_empty());
         hub.push_message(&state(8, &q, false));
         assert!(hub.snapshot().shapes.is_empty(), "NaN state drew a hand");
+    }
+
+    fn shown_state(frame: u32, q: Vec<f32>, status: Status) -> ShownState {
+        ShownState {
+            frame,
+            q,
+            lost: status != Status::Tracking,
+            status,
+            rms_px: 0.5,
+            features_found: 30,
+            features_expected: 35,
+            iterations: 4,
+        }
+    }
+
+    #[test]
+    fn hypotheses_are_shown_with_their_own_frame_and_never_while_searching() {
+        let hub = Hub::new(Model::hand().unwrap(), vec![], "test");
+        let mut bent = rest();
+        bent[8] = 1.0;
+        let hypotheses = [
+            ShownHypothesis {
+                rank: 0,
+                score: 0.9,
+                age: 5,
+                q: rest(),
+            },
+            ShownHypothesis {
+                rank: 1,
+                score: 0.85,
+                age: 0,
+                q: bent.clone(),
+            },
+        ];
+        // Told before their state arrives: not shown with the previous frame's state, whose
+        // own are still shown.
+        hub.push_state(shown_state(3, rest(), Status::Tracking));
+        hub.push_hypotheses(3, &hypotheses[..1]);
+        hub.push_hypotheses(4, &hypotheses);
+        assert!(hub.snapshot().ghosts.is_empty());
+        assert_eq!(hub.snapshot().hypotheses, 1);
+        hub.push_state(shown_state(4, rest(), Status::Tracking));
+        let s = hub.snapshot();
+        assert_eq!((s.hypotheses, s.best_score), (2, Some(0.9)));
+        assert_eq!(s.ghosts.len(), 1);
+        assert_eq!((s.ghosts[0].rank, s.ghosts[0].q[8]), (1, 1.0));
+        assert_eq!(s.ghosts[0].shapes.len(), 16);
+        // The next frame without hypotheses told: none shown.
+        hub.push_state(shown_state(5, rest(), Status::Tracking));
+        assert!(hub.snapshot().ghosts.is_empty());
+        // Searching: none, even when told.
+        hub.push_hypotheses(6, &hypotheses);
+        hub.push_state(shown_state(6, rest(), Status::Searching));
+        assert!(hub.snapshot().ghosts.is_empty());
+        let json = serde_json::to_value(hub.snapshot()).unwrap();
+        assert_eq!(json["ghosts"], serde_json::json!([]));
     }
 
     #[test]

@@ -59,6 +59,8 @@ pub enum UiSource {
         seqdir: PathBuf,
         /// The states tracked for it (`track` or `stream` output).
         states: PathBuf,
+        /// The hypotheses tracked for it (`track --hypotheses-out`): the others drawn ghosted.
+        hypotheses: Option<PathBuf>,
         /// The camera whose frames to show.
         camera: usize,
         /// Frames/s (default: the sequence's).
@@ -228,10 +230,12 @@ fn start_source(
         UiSource::Replay {
             seqdir,
             states,
+            hypotheses,
             camera,
             fps,
         } => {
-            let replay = sources::Replay::open(seqdir, states, *camera, *fps)?;
+            let replay =
+                sources::Replay::open(seqdir, states, hypotheses.as_deref(), *camera, *fps)?;
             let sequence = Sequence::open(seqdir)?;
             let hub = Hub::new(
                 sequence.model.clone(),

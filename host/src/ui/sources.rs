@@ -13,8 +13,9 @@ use digiteyes_core::camera::Camera;
 use digiteyes_core::protocol::BoardMessage;
 use digiteyes_core::status::Status;
 
-use super::hub::{CameraFrame, Hub, ShownState};
+use super::hub::{CameraFrame, Hub, ShownHypothesis, ShownState};
 use crate::link::Link;
+use crate::sequence::hypotheses::read_hypotheses;
 use crate::sequence::states::read_states_with_gaps;
 use crate::sequence::Sequence;
 use crate::stream::STATUS_COLUMN;
@@ -78,6 +79,8 @@ pub fn udp(socket: &UdpSocket, hub: &Hub, stop: &AtomicBool) -> Result<()> {
 pub struct Replay {
     sequence: Sequence,
     states: Vec<(ShownState, Option<String>)>,
+    /// Each frame's hypotheses, best first, when a hypotheses CSV was given.
+    hypotheses: Option<Vec<Vec<ShownHypothesis>>>,
     camera: Camera,
     camera_index: usize,
     period: Duration,
@@ -86,10 +89,12 @@ pub struct Replay {
 impl Replay {
     /// Opens `seqdir` and `states_csv` (the output of `track` or `stream`), to be shown as
     /// camera `camera_index` saw it, at the sequence's frame rate (`fps` overrides; 15 when
-    /// neither gives one).
+    /// neither gives one). With `hypotheses_csv` (`track --hypotheses-out`), each frame's
+    /// other hypotheses are shown ghosted behind the hand.
     pub fn open(
         seqdir: &Path,
         states_csv: &Path,
+        hypotheses_csv: Option<&Path>,
         camera_index: usize,
         fps: Option<f64>,
     ) -> Result<Replay> {
@@ -132,6 +137,36 @@ impl Replay {
                 (shown, drop)
             })
             .collect();
+        let hypotheses = match hypotheses_csv {
+            Some(path) => {
+                let table = read_hypotheses(path, sequence.n_states())?;
+                if let Some(last) = table.last_frame().filter(|&f| f >= rows) {
+                    bail!(
+                        "{}: frame {last} is past the last frame of {} ({rows} frames): the \
+                         hypotheses of another run?",
+                        path.display(),
+                        states_csv.display()
+                    );
+                }
+                let frames = table.by_frame(rows);
+                Some(
+                    frames
+                        .iter()
+                        .map(|rows| {
+                            rows.iter()
+                                .map(|r| ShownHypothesis {
+                                    rank: r.rank.min(usize::from(u8::MAX)) as u8,
+                                    score: r.score as f32,
+                                    age: r.age.min(u64::from(u32::MAX)) as u32,
+                                    q: r.state.iter().map(|&v| v as f32).collect(),
+                                })
+                                .collect()
+                        })
+                        .collect(),
+                )
+            }
+            None => None,
+        };
         let fps = match (fps, sequence.fps()) {
             (Some(fps), _) => {
                 crate::cli_values::check_fps(fps).map_err(|e| anyhow::anyhow!("--fps: {e}"))?;
@@ -151,6 +186,7 @@ impl Replay {
         Ok(Replay {
             sequence,
             states,
+            hypotheses,
             camera,
             camera_index,
             period: crate::cli_values::frame_period(fps),
@@ -212,6 +248,9 @@ impl Replay {
                         last_complaint = Some(Instant::now());
                     }
                 }
+            }
+            if let Some(frames) = &self.hypotheses {
+                hub.push_hypotheses(state.frame, &frames[i]);
             }
             match drop {
                 Some(reason) => hub.push_host_drop(reason),

@@ -81,6 +81,7 @@ function drawHand() {
         : look === "hidden" ? "searching for the hand…" : "the state does not fit the model",
       20, 30);
     document.body.dataset.shapesDrawn = "0";
+    document.body.dataset.ghostsDrawn = "0";
     return;
   }
   const palm = shapes.find((s) => s.kind === "box");
@@ -92,6 +93,7 @@ function drawHand() {
   const onTable = !!palm &&
     palm.centre[2] - [0, 1, 2].reduce((z, k) => z + Math.abs(palm.axes[k][2] * palm.half[k]), 0) > 0;
   if (onTable) drawGrid(ctx, cam);
+  document.body.dataset.ghostsDrawn = String(drawGhosts(ctx, cam, snap.ghosts || []));
   const light = norm([0.3, -0.5, 1]);
   const skin = [228, 180, 150];
   for (const s of shapes) {
@@ -171,6 +173,47 @@ function drawHand() {
   }
   document.body.dataset.shapesDrawn = String(shapes.length);
 }
+
+// The tracker's other hypotheses (rank 1 and up), behind the hand: thin, pale outlines.
+// Returns how many were drawn.
+function drawGhosts(ctx, cam, ghosts) {
+  let drawn = 0;
+  ctx.save();
+  ctx.lineCap = "round";
+  for (const g of ghosts) {
+    const shapes = g.shapes || [];
+    if (!shapes.length) continue;
+    ctx.strokeStyle = "rgba(70,100,160,0.35)";
+    ctx.lineWidth = 1.5;
+    for (const s of shapes) {
+      if (s.kind === "capsule") {
+        const a = cam.project(s.a), b = cam.project(s.b);
+        if (a.z <= 1 || b.z <= 1) continue;
+        ctx.beginPath(); ctx.moveTo(a.x, a.y); ctx.lineTo(b.x, b.y); ctx.stroke();
+      } else if (s.kind === "box") {
+        const corner = (i, j, k) => cam.project(add(s.centre, add(mul(s.axes[0], i * s.half[0]),
+          add(mul(s.axes[1], j * s.half[1]), mul(s.axes[2], k * s.half[2])))));
+        for (const [p, q] of BOX_EDGES) {
+          const a = corner(...p), b = corner(...q);
+          if (a.z <= 1 || b.z <= 1) continue;
+          ctx.beginPath(); ctx.moveTo(a.x, a.y); ctx.lineTo(b.x, b.y); ctx.stroke();
+        }
+      }
+    }
+    drawn += 1;
+  }
+  ctx.restore();
+  return drawn;
+}
+
+// A box's 12 edges, as pairs of corners (signs along its three axes).
+const BOX_EDGES = (() => {
+  const edges = [];
+  for (const i of [-1, 1]) for (const j of [-1, 1]) {
+    edges.push([[-1, i, j], [1, i, j]], [[i, -1, j], [i, 1, j]], [[i, j, -1], [i, j, 1]]);
+  }
+  return edges;
+})();
 
 function drawGrid(ctx, cam) {
   const t = view.target;
@@ -451,7 +494,10 @@ function updatePanels() {
   }
   $("frame").textContent = s
     ? `frame ${s.frame} · ${word} · rms ${Number.isFinite(s.rms_px) ? s.rms_px.toFixed(2) : "–"} px · ` +
-      `${s.features_found}/${s.features_expected} features · ${s.iterations} iterations`
+      `${s.features_found}/${s.features_expected} features · ${s.iterations} iterations` +
+      (snap.hypotheses > 1
+        ? ` · ${snap.hypotheses} hypotheses, the best scoring ${Number(snap.best_score).toFixed(3)}`
+        : "")
     : "no state yet";
   document.body.dataset.frame = s ? String(s.frame) : "";
   document.title = s ? `digiteyes · frame ${s.frame}` : "digiteyes";
