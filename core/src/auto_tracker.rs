@@ -7,7 +7,10 @@
 //!   ([`AcceptConfig`]); an accepted leaf is taken for the hand, and when every leaf is
 //!   refused the search starts over.
 //! - **Tracking**: the tracker runs — one hypothesis, or several ([`MultiTracker`], set by
-//!   [`AutoTracker::set_hypotheses`]); a lost frame makes the status [`Status::Lost`].
+//!   [`AutoTracker::set_hypotheses`]); a lost frame makes the status [`Status::Lost`]. Every
+//!   few frames the [watch](crate::watch) scores the tracked state by the likelihood in every
+//!   camera; a state some camera does not support is a lost frame too, and is checked again
+//!   on every frame until a check passes (not with [`Recovery::Never`], the plain tracker).
 //! - **Lost**: the tracker still runs (holding its last good state); a frame not lost makes it
 //!   `Tracking` again, [`LOST_FRAMES_BEFORE_SEARCH`] lost frames in a row make it `Searching`
 //!   (unless [`Recovery::Never`]: then it stays `Lost`, as the plain tracker does).
@@ -41,6 +44,7 @@ use crate::likelihood::{EdgeMap, LikelihoodError};
 use crate::model::Model;
 pub use crate::status::Status;
 use crate::tracker::{FrameReport, Tracker, TrackerConfig, TrackerError};
+use crate::watch::{Watch, WatchConfig};
 
 /// Lost frames in a row after which the tracker gives the hand up and searches again.
 pub const LOST_FRAMES_BEFORE_SEARCH: u32 = 10;
@@ -130,6 +134,9 @@ pub struct AutoReport {
     /// The best hypothesis is not the previous frame's best (a tracking frame with several
     /// hypotheses whose ranking changed; false otherwise).
     pub switched: bool,
+    /// The tracked state's likelihood score in its worst camera, on a frame the
+    /// [watch](crate::watch) checked (a score under its bar made the frame lost).
+    pub watch_score: Option<f32>,
 }
 
 /// A hypothesis refined on this frame: its state, its mean and worst camera's likelihood
@@ -158,6 +165,10 @@ pub struct AutoTracker {
     /// [`LOCAL_FOLLOW_SCORE`]: refined again on the next.
     following: Option<[f32; MAX_STATES]>,
     recovery: Recovery,
+    /// The image's check on the track.
+    watch: Watch,
+    /// The state at the last check the track passed (or at its start).
+    vouched: heapless::Vec<f32, MAX_STATES>,
 }
 
 impl AutoTracker {
@@ -188,6 +199,8 @@ impl AutoTracker {
             local_left: 0,
             following: None,
             recovery: Recovery::Search,
+            watch: Watch::new(WatchConfig::default()),
+            vouched: heapless::Vec::new(),
         })
     }
 
@@ -202,6 +215,7 @@ impl AutoTracker {
         acquire: AcquireConfig,
     ) -> Result<Self, AutoError> {
         let mut auto = AutoTracker::new(model, cameras, initial, free, config, acquire)?;
+        auto.vouched = auto.multi.tracker().memory().state;
         auto.status = Status::Tracking;
         auto.ever_tracked = true;
         Ok(auto)
@@ -225,6 +239,11 @@ impl AutoTracker {
     /// The acceptance thresholds.
     pub fn accept(&self) -> AcceptConfig {
         self.finder.config().accept
+    }
+
+    /// Sets how the image checks the track ([`crate::watch`]; `every_frames` 0: never).
+    pub fn set_watch(&mut self, config: WatchConfig) {
+        self.watch = Watch::new(config);
     }
 
     /// Sets what happens once the hand is lost for [`LOST_FRAMES_BEFORE_SEARCH`] frames.
@@ -293,7 +312,21 @@ impl AutoTracker {
         edge_buffers: &mut [&mut [u8]],
     ) -> Result<AutoReport, AutoError> {
         let multi = self.multi.track(frames, edge_buffers)?;
-        let report = multi.report;
+        let mut report = multi.report;
+        let mut watch_score = None;
+        if !report.lost && self.recovery == Recovery::Search && self.watch.due() {
+            let worst = self.worst_camera_score(frames, edge_buffers)?;
+            watch_score = Some(worst);
+            if self.watch.judge(worst) {
+                self.vouched = self.multi.tracker().memory().state;
+            } else {
+                // The image does not support the track: a lost frame, and what was last
+                // vouched for is what the hand is held at.
+                report.lost = true;
+                let n = self.vouched.len().min(MAX_STATES);
+                self.held[..n].copy_from_slice(&self.vouched[..n]);
+            }
+        }
         if report.lost {
             self.lost_run = self.lost_run.saturating_add(1);
             self.status = if self.lost_run >= LOST_FRAMES_BEFORE_SEARCH
@@ -324,7 +357,41 @@ impl AutoTracker {
             hypotheses: multi.count,
             best_score: multi.score,
             switched: multi.switched,
+            watch_score,
         })
+    }
+
+    /// The tracked state's likelihood score in its worst camera, each camera's edge map built
+    /// for it.
+    fn worst_camera_score(
+        &mut self,
+        frames: &[FrameView<'_>],
+        edge_buffers: &mut [&mut [u8]],
+    ) -> Result<f32, AutoError> {
+        if edge_buffers.len() < frames.len() {
+            return Err(AutoError::BufferCount);
+        }
+        let likelihood = self.finder.acquirer().config().likelihood;
+        let mut maps: Vec<EdgeMap<'_>, MAX_CAMERAS> = Vec::new();
+        for (buffer, frame) in edge_buffers.iter_mut().zip(frames) {
+            let map = EdgeMap::build(buffer, frame, &likelihood).map_err(AutoError::EdgeMap)?;
+            if maps.push(map).is_err() {
+                return Err(AutoError::Tracker(TrackerError::CameraCount));
+            }
+        }
+        let mut q = [0.0f32; MAX_STATES];
+        let tracker = self.multi.tracker();
+        for (d, s) in q.iter_mut().zip(tracker.state()) {
+            *d = *s;
+        }
+        let (_, worst) = self.finder.acquirer_mut().score_cameras(
+            tracker.model(),
+            tracker.cameras(),
+            frames,
+            &maps,
+            &q,
+        );
+        Ok(worst)
     }
 
     /// Keeps the tracker's state as the last that claimed the hand.
@@ -338,6 +405,8 @@ impl AutoTracker {
     /// The tracker holds the hand (refined on this frame): the status becomes `Tracking`.
     fn found(&mut self) {
         self.multi.adopt();
+        self.watch.clear();
+        self.vouched = self.multi.tracker().memory().state;
         self.status = Status::Tracking;
         self.lost_run = 0;
         self.local_left = 0;

@@ -62,5 +62,6 @@ pub mod state;
 pub mod status;
 pub mod tracker;
 pub mod visibility;
+pub mod watch;
 
 pub use nalgebra;
