@@ -7,9 +7,9 @@ use digiteyes_core::auto_tracker::{AutoError, AutoTracker};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
+use digiteyes_core::hypotheses::HypothesesConfig;
 use digiteyes_core::measurement::measure_links;
 use digiteyes_core::model::Model;
-use digiteyes_core::hypotheses::HypothesesConfig;
 use digiteyes_core::protocol::{
     encode, hypotheses_in_range, model_digest, BoardMessage, Capacities, Command, Configure,
     Decoder, DropReason, Dropped, Features, FrameChunk, Hello, HostMessage, Hypotheses, Measure,

@@ -108,7 +108,11 @@ fn board_matches_in_process(k: u8) -> usize {
             other => panic!("K = {k}, frame {n}: a State then Hypotheses expected, got {other:?}"),
         };
         assert_eq!((state.frame, hypotheses.frame), (n, n));
-        assert_eq!(bits(&state.q), bits(reference.state()), "K = {k}, frame {n}");
+        assert_eq!(
+            bits(&state.q),
+            bits(reference.state()),
+            "K = {k}, frame {n}"
+        );
         assert_eq!(
             Status::from(state.status),
             expected.status,
@@ -136,7 +140,11 @@ fn board_matches_in_process(k: u8) -> usize {
             .collect();
         let got: Vec<_> = hypotheses.hypotheses.iter().map(hypothesis_bits).collect();
         assert_eq!(got, want, "K = {k}, frame {n}: the hypotheses");
-        assert_eq!(got.len(), usize::from(expected.hypotheses), "K = {k}, frame {n}");
+        assert_eq!(
+            got.len(),
+            usize::from(expected.hypotheses),
+            "K = {k}, frame {n}"
+        );
         assert!(got.len() <= usize::from(k));
         // The best hypothesis is the state reported.
         assert_eq!(got[0].2, bits(&state.q), "K = {k}, frame {n}: best first");

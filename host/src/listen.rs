@@ -207,7 +207,11 @@ pub fn describe(message: &BoardMessage) -> String {
                 "hypotheses {}: {} carried{}{}",
                 h.frame,
                 h.hypotheses.len(),
-                if each.is_empty() { "" } else { ", best first: " },
+                if each.is_empty() {
+                    ""
+                } else {
+                    ", best first: "
+                },
                 each.join(", ")
             )
         }

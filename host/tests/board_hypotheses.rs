@@ -62,7 +62,11 @@ fn stream_with_hypotheses_counts_what_the_board_carried() {
         .unwrap_or_else(|| panic!("a hypotheses line: {stdout}"));
     // "  hypotheses: 4 messages, 2.50 carried on average (best's mean score 0.850)"
     let words: Vec<&str> = line.split_whitespace().collect();
-    assert_eq!(words[1], frames.to_string(), "one message per frame: {line}");
+    assert_eq!(
+        words[1],
+        frames.to_string(),
+        "one message per frame: {line}"
+    );
     let mean: f64 = words[3].parse().unwrap();
     assert!((1.0..=3.0).contains(&mean), "{line}");
     assert!(
@@ -175,7 +179,10 @@ fn listen_prints_each_hypotheses_message_and_counts_them() {
         lines[1],
         "hypotheses 7: 3 carried, best first: 0.9000 (age 10), 0.8750 (age 9), 0.5000 (age 8)"
     );
-    assert_eq!(lines[3], "hypotheses 8: 1 carried, best first: 0.7500 (age 10)");
+    assert_eq!(
+        lines[3],
+        "hypotheses 8: 1 carried, best first: 0.7500 (age 10)"
+    );
     assert!(
         summary
             .iter()
@@ -202,7 +209,13 @@ fn a_hypothesis_count_out_of_range_or_with_a_board_per_camera_is_refused_clearly
         );
     }
     let out = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
-        .args(["stream", "--port", "/nonexistent/a", "--port", "/nonexistent/b"])
+        .args([
+            "stream",
+            "--port",
+            "/nonexistent/a",
+            "--port",
+            "/nonexistent/b",
+        ])
         .args(["--seq", "stereo", "--hypotheses", "2"])
         .current_dir(dir.path())
         .output()
