@@ -5,10 +5,13 @@
 //! - a stream of valid messages with bytes corrupted at random: every message whose frame (and
 //!   both delimiters around it) was untouched decodes exactly as sent — the decoder is back in
 //!   step at the first clean frame — and no corrupted frame is ever taken for a message;
-//! - random host messages round-trip.
+//! - random host messages round-trip;
+//! - random `Hypotheses` (version 5: up to 8 hypotheses of up to 32 states, any floats) fit
+//!   `MAX_MESSAGE`, round-trip, and decode from a stream cut into random pieces.
 //!
 //! Case counts: 4000 random streams (up to 4 KiB each), 4000 corrupted streams (8–40
-//! messages each, corruption rates up to 5 %), 4000 round trips: 12,000 cases, a few seconds.
+//! messages each, corruption rates up to 5 %), 4000 round trips, 2000 `Hypotheses`: 14,000
+//! cases, a few seconds.
 
 use digiteyes_core::protocol::*;
 use proptest::prelude::*;
@@ -28,6 +31,7 @@ enum Owned {
     Ping(u32),
     Chunk(u32, u16, u16, u32, Vec<u8>),
     Reset(Vec<f32>, u32, bool),
+    Configure(u16, u8),
 }
 
 impl Owned {
@@ -47,6 +51,20 @@ impl Owned {
                 q: q.iter().copied().collect(),
                 free: *free,
                 start: if *search { Start::Search } else { Start::Given },
+            }),
+            Owned::Configure(budget, hypotheses) => HostMessage::Configure(Configure {
+                camera: CameraParams {
+                    width: 320,
+                    height: 240,
+                    intrinsics: [500.0, 500.0, 159.5, 119.5],
+                    r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+                    t: [0.0, 0.0, 600.0],
+                },
+                tracker: TrackerParams::default(),
+                features_every: 0,
+                stats_every: 0,
+                search_evaluations_per_frame: *budget,
+                hypotheses: *hypotheses,
             }),
         }
     }
@@ -69,7 +87,34 @@ fn owned() -> impl Strategy<Value = Owned> {
             any::<bool>()
         )
             .prop_map(|(q, free, search)| Owned::Reset(q, free, search)),
+        (any::<u16>(), any::<u8>()).prop_map(|(b, k)| Owned::Configure(b, k)),
     ]
+}
+
+/// A random `Hypotheses` message (version 5).
+fn hypotheses() -> impl Strategy<Value = BoardMessage> {
+    let one = (
+        any::<f32>(),
+        any::<u32>(),
+        prop::collection::vec(any::<f32>(), 0..=32),
+    );
+    (
+        any::<u32>(),
+        prop::collection::vec(one, 0..=digiteyes_core::config::MAX_HYPOTHESES),
+    )
+        .prop_map(|(frame, list)| {
+            BoardMessage::Hypotheses(Hypotheses {
+                frame,
+                hypotheses: list
+                    .into_iter()
+                    .map(|(score, age, q)| WireHypothesis {
+                        score,
+                        age,
+                        q: q.into_iter().collect(),
+                    })
+                    .collect(),
+            })
+        })
 }
 
 proptest! {
@@ -177,5 +222,33 @@ proptest! {
         let back = out.unwrap().unwrap();
         // Compare encodings: NaN states are not equal to themselves.
         prop_assert_eq!(frame_of(&back), f);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(CASES / 2))]
+
+    #[test]
+    fn hypotheses_fit_and_round_trip_in_pieces(message in hypotheses(), piece in 1usize..64) {
+        let mut buf = [0u8; MAX_MESSAGE];
+        let f = encode(&message, &mut buf).unwrap().to_vec();
+        prop_assert!(f.len() <= 1122, "{} bytes", f.len());
+        let mut rx = Rx::new();
+        let mut got = Vec::new();
+        for chunk in f.chunks(piece) {
+            let mut rest = chunk;
+            while !rest.is_empty() {
+                let (used, out) = rx.feed::<BoardMessage>(rest);
+                if let Some(out) = out {
+                    got.push(out);
+                }
+                rest = &rest[used..];
+            }
+        }
+        prop_assert_eq!(got.len(), 1);
+        let back = got.pop().unwrap().unwrap();
+        // Compare encodings: NaN scores and states are not equal to themselves.
+        let mut again = [0u8; MAX_MESSAGE];
+        prop_assert_eq!(encode(&back, &mut again).unwrap(), &f[..]);
     }
 }

@@ -126,7 +126,23 @@ fn board_messages() -> std::vec::Vec<BoardMessage> {
             silhouette: Some(f32::NAN),
         }),
         BoardMessage::Ack(Command::Hold),
+        // The largest Hypotheses: every hypothesis a board carries, each with every state a
+        // message carries, worst-case varints (version 5).
+        largest_hypotheses(),
     ]
+}
+
+fn largest_hypotheses() -> BoardMessage {
+    BoardMessage::Hypotheses(Hypotheses {
+        frame: u32::MAX,
+        hypotheses: (0..digiteyes_core::config::MAX_HYPOTHESES)
+            .map(|i| WireHypothesis {
+                score: -(i as f32) / 3.0,
+                age: u32::MAX,
+                q: full_q(32),
+            })
+            .collect(),
+    })
 }
 
 fn host_messages(data: &[u8]) -> std::vec::Vec<HostMessage<'_>> {
@@ -142,6 +158,7 @@ fn host_messages(data: &[u8]) -> std::vec::Vec<HostMessage<'_>> {
             features_every: u16::MAX,
             stats_every: u16::MAX,
             search_evaluations_per_frame: u16::MAX,
+            hypotheses: u8::MAX,
         }),
         HostMessage::FrameChunk(FrameChunk {
             frame: u32::MAX,
@@ -462,4 +479,26 @@ fn drop_counts_record_each_reason_in_its_counter_and_total_them() {
     counts.tracker_error = u32::MAX;
     counts.record(&DropReason::TrackerError);
     assert_eq!((counts.tracker_error, counts.total()), (u32::MAX, u32::MAX));
+}
+
+/// The hypothesis count a board takes is 1..=MAX_HYPOTHESES, and the host's default is in it;
+/// the largest `Hypotheses` (8 × 32 states) is well within `MAX_MESSAGE`.
+#[test]
+fn hypothesis_counts_and_the_largest_hypotheses_message() {
+    use digiteyes_core::config::MAX_HYPOTHESES;
+    assert!(!hypotheses_in_range(0));
+    assert!((1..=MAX_HYPOTHESES as u8).all(hypotheses_in_range));
+    assert!(!hypotheses_in_range(MAX_HYPOTHESES as u8 + 1));
+    assert!(!hypotheses_in_range(u8::MAX));
+    assert!(hypotheses_in_range(default_hypotheses()));
+    let mut buf = [0u8; MAX_MESSAGE];
+    let message = largest_hypotheses();
+    let n = encode(&message, &mut buf).unwrap().len();
+    // Body 1,111 bytes + CRC 4, COBS at most 5 more, 2 delimiters: 1,122 at most
+    // (docs/protocol.md §11); these values need 1,118.
+    assert!((1100..=1122).contains(&n), "{n} bytes");
+    let BoardMessage::Hypotheses(h) = message else {
+        unreachable!()
+    };
+    assert_eq!(h.hypotheses.len(), MAX_HYPOTHESES);
 }

@@ -7,12 +7,14 @@ use digiteyes_core::auto_tracker::{AutoError, AutoTracker};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
+use digiteyes_core::hypotheses::HypothesesConfig;
 use digiteyes_core::measurement::measure_links;
 use digiteyes_core::model::Model;
 use digiteyes_core::protocol::{
-    encode, model_digest, BoardMessage, Capacities, Command, Configure, Decoder, DropReason,
-    Dropped, Features, FrameChunk, Hello, HostMessage, Measure, Measured, Refusal, Reset, Start,
-    State, Stats, MAX_CHUNK, MAX_MESSAGE, PROTOCOL_VERSION,
+    encode, hypotheses_in_range, model_digest, BoardMessage, Capacities, Command, Configure,
+    Decoder, DropReason, Dropped, Features, FrameChunk, Hello, HostMessage, Hypotheses, Measure,
+    Measured, Refusal, Reset, Start, State, Stats, WireHypothesis, MAX_CHUNK, MAX_MESSAGE,
+    PROTOCOL_VERSION,
 };
 use digiteyes_core::remote::MeasureWork;
 use digiteyes_core::status::Status;
@@ -24,7 +26,7 @@ use heapless::{String, Vec};
 
 use crate::clock::Clock;
 use crate::log::{info, log_warn};
-use crate::memory::{search_config, Buffers};
+use crate::memory::{hypotheses_config, search_config, Buffers};
 use crate::overlay;
 use crate::source::FrameSource;
 use crate::upload::{ChunkOutcome, Upload};
@@ -39,6 +41,8 @@ struct Setup {
     config: TrackerConfig,
     /// The search's parameters (its budget from `Configure`, the rest the board's).
     acquire: AcquireConfig,
+    /// The hypotheses tracked (their count from `Configure`, the rest the board's).
+    hypotheses: HypothesesConfig,
     features_every: u16,
     stats_every: u16,
 }
@@ -326,10 +330,12 @@ where
             .tracker
             .to_config()
             .map_err(|_| Refusal::BadParameters)?;
-        if configure.search_evaluations_per_frame == 0 {
+        if configure.search_evaluations_per_frame == 0 || !hypotheses_in_range(configure.hypotheses)
+        {
             return Err(Refusal::BadParameters);
         }
         let acquire = search_config(configure.search_evaluations_per_frame);
+        let hypotheses = hypotheses_config(configure.hypotheses);
         if configure.camera.frame_bytes() > self.frame.len()
             || AutoTracker::edge_bytes_needed(&camera, &acquire) > self.edge_map.len()
         {
@@ -344,7 +350,7 @@ where
                 // parameters. `AutoTracker` cannot be reconfigured in place, so the motion
                 // (the velocity of the next prediction) starts over; a `Configure` that
                 // changes neither keeps everything (docs/protocol.md §6).
-                let rebuilt = rebuild(&auto, camera, config, acquire);
+                let rebuilt = rebuild(&auto, camera, config, acquire, hypotheses);
                 match rebuilt {
                     Ok(fresh) => self.tracker = Some(fresh),
                     Err(refusal) => {
@@ -353,11 +359,16 @@ where
                     }
                 }
             }
+        } else if let Some(auto) = self.tracker.as_mut() {
+            // Only the count (or nothing) changed: the status machine keeps its motion, and
+            // the hypotheses beyond a smaller count are dropped.
+            auto.set_hypotheses(hypotheses);
         }
         self.setup = Some(Setup {
             camera,
             config,
             acquire,
+            hypotheses,
             features_every: configure.features_every,
             stats_every: configure.stats_every,
         });
@@ -399,11 +410,13 @@ where
         }
         let cameras = [setup.camera];
         let (free, config, acquire) = (FreeMask(free), setup.config, setup.acquire);
-        match start {
+        let mut auto = match start {
             Start::Given => AutoTracker::tracking(model, &cameras, q, free, config, acquire),
             Start::Search => AutoTracker::new(model, &cameras, q, free, config, acquire),
         }
-        .map_err(refusal_of)
+        .map_err(refusal_of)?;
+        auto.set_hypotheses(setup.hypotheses);
+        Ok(auto)
     }
 
     /// Drops and reports a partly uploaded frame: after a new setup its chunks no longer fit.
@@ -530,6 +543,18 @@ where
                 ),
                 Err(_) => Vec::new(),
             });
+        // With several hypotheses, they follow the State: best first, none while searching
+        // (no hand claimed, so none carried).
+        let carried = (setup.hypotheses.count > 1).then(|| {
+            let list = match status {
+                Status::Searching => &[][..],
+                Status::Tracking | Status::Lost => tracker.hypotheses(),
+            };
+            Hypotheses {
+                frame,
+                hypotheses: list.iter().map(WireHypothesis::from).collect(),
+            }
+        });
         self.set_led(status.claims_hand());
         self.send(&BoardMessage::State(State {
             frame,
@@ -546,6 +571,9 @@ where
             status: status.into(),
             search_evaluations: outcome.evaluated,
         }))?;
+        if let Some(hypotheses) = carried {
+            self.send(&BoardMessage::Hypotheses(hypotheses))?;
+        }
         if let Some(links) = measurements {
             self.send(&BoardMessage::Features(Features {
                 frame,
@@ -611,17 +639,20 @@ fn rebuild(
     camera: Camera,
     config: TrackerConfig,
     acquire: AcquireConfig,
+    hypotheses: HypothesesConfig,
 ) -> Result<AutoTracker, Refusal> {
     let tracker = auto.tracker();
     let (model, free, cameras) = (tracker.model().clone(), tracker.free(), [camera]);
     let q = auto.state();
-    match auto.status() {
+    let mut fresh = match auto.status() {
         Status::Tracking | Status::Lost => {
             AutoTracker::tracking(model, &cameras, q, free, config, acquire)
         }
         Status::Searching => AutoTracker::new(model, &cameras, q, free, config, acquire),
     }
-    .map_err(refusal_of)
+    .map_err(refusal_of)?;
+    fresh.set_hypotheses(hypotheses);
+    Ok(fresh)
 }
 
 /// The refusal for a tracker that could not be built.

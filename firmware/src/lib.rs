@@ -34,6 +34,6 @@ mod upload;
 pub use board::{Board, Tap, Tracked};
 pub use clock::Clock;
 pub use led::NoLed;
-pub use memory::{edge_map_bytes, search_config, Buffers, SEARCH_STRIDE_PX};
+pub use memory::{edge_map_bytes, hypotheses_config, search_config, Buffers, SEARCH_STRIDE_PX};
 pub use source::{FrameSource, SourceError, Uploads};
 pub use upload::{ChunkOutcome, Upload};

@@ -3,9 +3,13 @@
 //! The board's search ([`AutoTracker`](digiteyes_core::auto_tracker::AutoTracker)) needs an
 //! edge map of the frame: per cell of [`SEARCH_STRIDE_PX`] × [`SEARCH_STRIDE_PX`] px, one
 //! byte per orientation bin ([`EDGE_BINS`]). A board crate sizes it for its largest frame
-//! with [`edge_map_bytes`], a `const fn`, so it can live in a `static`.
+//! with [`edge_map_bytes`], a `const fn`, so it can live in a `static`. The same buffer
+//! serves the likelihood of several hypotheses ([`hypotheses_config`]: the same stride), which
+//! builds its map on tracking frames, while the search builds its own on searching frames:
+//! never both on one frame.
 
 use digiteyes_core::acquire::AcquireConfig;
+use digiteyes_core::hypotheses::HypothesesConfig;
 use digiteyes_core::likelihood::{LikelihoodConfig, EDGE_BINS};
 
 /// Side of an edge-map cell (px) on a board: the search's default (4 keeps a VGA frame's map
@@ -24,6 +28,21 @@ pub fn search_config(evaluations_per_frame: u16) -> AcquireConfig {
     let defaults = AcquireConfig::default();
     AcquireConfig {
         evaluations_per_frame,
+        likelihood: LikelihoodConfig {
+            stride_px: SEARCH_STRIDE_PX,
+            ..defaults.likelihood
+        },
+        ..defaults
+    }
+}
+
+/// The hypotheses a board tracks: the tracker's defaults, `count` of them (`Configure`'s
+/// `hypotheses`), their likelihood's edge map at [`SEARCH_STRIDE_PX`] so it fits the
+/// search's buffer ([`Buffers::edge_map`]).
+pub fn hypotheses_config(count: u8) -> HypothesesConfig {
+    let defaults = HypothesesConfig::default();
+    HypothesesConfig {
+        count,
         likelihood: LikelihoodConfig {
             stride_px: SEARCH_STRIDE_PX,
             ..defaults.likelihood
@@ -60,5 +79,23 @@ mod tests {
             );
         }
         assert_eq!(edge_map_bytes(640, 480), 115_200);
+    }
+
+    /// Several hypotheses build their likelihood's edge map in the search's buffer: the same
+    /// stride, so the same bytes.
+    #[test]
+    fn the_hypotheses_edge_map_fits_the_search_buffer() {
+        for k in 1..=8u8 {
+            let config = hypotheses_config(k);
+            assert_eq!(config.count, k);
+            assert_eq!(config.likelihood.stride_px, SEARCH_STRIDE_PX);
+            for (w, h) in [(640, 480), (320, 240), (161, 119)] {
+                assert_eq!(
+                    EdgeMap::bytes_needed(w, h, config.likelihood.stride_px),
+                    edge_map_bytes(w, h),
+                    "{w}x{h}"
+                );
+            }
+        }
     }
 }

@@ -28,6 +28,7 @@ fn configure(stats_every: u16, features_every: u16) -> HostMessage<'static> {
         features_every,
         stats_every,
         search_evaluations_per_frame: default_search_evaluations(),
+        hypotheses: 1,
     })
 }
 
@@ -342,6 +343,7 @@ fn bad_commands_are_refused_and_change_nothing() {
         features_every: 0,
         stats_every: 0,
         search_evaluations_per_frame: default_search_evaluations(),
+        hypotheses: 1,
     }));
     params.iterations = 0;
     pipe.send(&HostMessage::Configure(Configure {
@@ -350,6 +352,7 @@ fn bad_commands_are_refused_and_change_nothing() {
         features_every: 0,
         stats_every: 0,
         search_evaluations_per_frame: default_search_evaluations(),
+        hypotheses: 1,
     }));
     let mut big = good_cam;
     big.width *= 2;
@@ -359,6 +362,7 @@ fn bad_commands_are_refused_and_change_nothing() {
         features_every: 0,
         stats_every: 0,
         search_evaluations_per_frame: default_search_evaluations(),
+        hypotheses: 1,
     }));
     pipe.send(&configure(0, 0));
     pipe.send(&HostMessage::Reset(Reset {

@@ -32,6 +32,7 @@ fn configure() -> HostMessage<'static> {
         features_every: 0,
         stats_every: 0,
         search_evaluations_per_frame: default_search_evaluations(),
+        hypotheses: 1,
     })
 }
 

@@ -38,6 +38,7 @@ fn configure(iterations: u8, budget: u16) -> HostMessage<'static> {
         features_every: 0,
         stats_every: 0,
         search_evaluations_per_frame: budget,
+        hypotheses: 1,
     })
 }
 

@@ -44,6 +44,7 @@ fn the_tap_sees_every_frame_of_a_pass_with_its_pixels_and_state() {
         features_every: 0,
         stats_every: 0,
         search_evaluations_per_frame: default_search_evaluations(),
+        hypotheses: 1,
     }));
     board.serial_mut().send(&HostMessage::Reset(Reset {
         q: q0.iter().copied().collect(),

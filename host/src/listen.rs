@@ -51,6 +51,10 @@ pub struct ListenSummary {
     /// Those states by the board's status: searching, tracking, lost ([`Status::ALL`]'s
     /// order).
     pub statuses: [usize; 3],
+    /// `Hypotheses` messages among them (a board tracking several hypotheses).
+    pub hypotheses_messages: usize,
+    /// The hypotheses they carried, summed.
+    pub hypotheses_carried: usize,
     /// Datagrams forwarded (to all targets).
     pub forwarded: usize,
     /// The host receiver's counters.
@@ -111,6 +115,10 @@ pub fn listen(link: Link, options: &ListenOptions, out: &mut dyn Write) -> Resul
             if let Some(i) = Status::ALL.iter().position(|&s| s == status) {
                 summary.statuses[i] += 1;
             }
+        }
+        if let BoardMessage::Hypotheses(h) = &message {
+            summary.hypotheses_messages += 1;
+            summary.hypotheses_carried += h.hypotheses.len();
         }
         if options.json {
             writeln!(out, "{}", serde_json::to_string(&message)?)?;
@@ -189,6 +197,24 @@ pub fn describe(message: &BoardMessage) -> String {
             e.edges.len(),
             if e.tip.is_some() { ", tip" } else { "" }
         ),
+        BoardMessage::Hypotheses(h) => {
+            let each: Vec<String> = h
+                .hypotheses
+                .iter()
+                .map(|x| format!("{:.4} (age {})", x.score, x.age))
+                .collect();
+            format!(
+                "hypotheses {}: {} carried{}{}",
+                h.frame,
+                h.hypotheses.len(),
+                if each.is_empty() {
+                    ""
+                } else {
+                    ", best first: "
+                },
+                each.join(", ")
+            )
+        }
         BoardMessage::Measured(m) => format!(
             "measured {} (iteration {}): {} links{}",
             m.frame,

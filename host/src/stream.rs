@@ -17,7 +17,9 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{anyhow, ensure, Context, Result};
-use digiteyes_core::protocol::{default_search_evaluations, Start, State, TrackerParams};
+use digiteyes_core::protocol::{
+    default_hypotheses, default_search_evaluations, Start, State, TrackerParams,
+};
 use digiteyes_core::status::Status;
 use digiteyes_core::tracker::FrameReport;
 use digiteyes_platform_linux::camera::V4l2Camera;
@@ -56,6 +58,9 @@ pub struct StreamOptions {
     pub start: Option<Start>,
     /// The board's search budget per frame, in evaluations (`Configure`).
     pub search_evaluations_per_frame: u16,
+    /// Hypotheses the board's tracker carries (`Configure`, 1..=8): more than 1 makes it
+    /// send them after every state; the summary counts them.
+    pub hypotheses: u8,
     /// Show a progress bar (when stderr is a terminal).
     pub progress: bool,
 }
@@ -71,6 +76,7 @@ impl StreamOptions {
             tracker: TrackerParams::default(),
             start: None,
             search_evaluations_per_frame: default_search_evaluations(),
+            hypotheses: default_hypotheses(),
             progress: false,
         }
     }
@@ -346,6 +352,7 @@ fn connect(sequence: &Sequence, options: &StreamOptions) -> Result<Session> {
         setup.start = start;
     }
     setup.search_evaluations_per_frame = options.search_evaluations_per_frame;
+    setup.hypotheses = options.hypotheses;
     setup.reply_timeout = options.reply_timeout;
     let link = Link::open(&options.port, options.baud)?;
     Session::start(link, setup)

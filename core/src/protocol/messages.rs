@@ -9,8 +9,9 @@ use serde::{Deserialize, Serialize};
 
 use super::params::{CameraParams, TrackerParams};
 use crate::acquire::AcquireConfig;
-use crate::config::{MAX_LINKS, MAX_STATES};
+use crate::config::{MAX_HYPOTHESES, MAX_LINKS, MAX_STATES};
 use crate::features::MAX_LINK_EDGES;
+use crate::hypotheses::{HypothesesConfig, Hypothesis};
 use crate::status::Status;
 
 /// Longest board name in [`Hello`] (bytes of UTF-8).
@@ -43,6 +44,9 @@ pub enum BoardMessage {
     LinkEdges(LinkEdges),
     /// The end of the answer to a [`HostMessage::Measure`] (version 3).
     Measured(Measured),
+    /// The hypotheses the board carries after a frame, best first: sent right after the
+    /// frame's [`State`] whenever [`Configure::hypotheses`] is more than 1 (version 5).
+    Hypotheses(Hypotheses),
 }
 
 /// Host → board.
@@ -383,11 +387,27 @@ pub struct Configure {
     /// searching board answers every frame after at most this much search work (and the one
     /// hypothesis under way).
     pub search_evaluations_per_frame: u16,
+    /// Hypotheses the tracker carries between frames, 1..=[`MAX_HYPOTHESES`] (version 5;
+    /// `hypotheses::HypothesesConfig::count`; default [`default_hypotheses`]): 1 is the
+    /// single tracker, bit for bit; more make the board send [`BoardMessage::Hypotheses`]
+    /// after every `State`. 0 or more than [`MAX_HYPOTHESES`] is refused
+    /// (`Nak(Configure, BadParameters)`).
+    pub hypotheses: u8,
 }
 
 /// The search budget per frame a host sends by default: the search's own default.
 pub fn default_search_evaluations() -> u16 {
     AcquireConfig::default().evaluations_per_frame
+}
+
+/// The hypothesis count a host sends by default: the tracker's own default.
+pub fn default_hypotheses() -> u8 {
+    HypothesesConfig::default().count
+}
+
+/// Whether `count` is a hypothesis count a board takes: 1..=[`MAX_HYPOTHESES`].
+pub fn hypotheses_in_range(count: u8) -> bool {
+    (1..=MAX_HYPOTHESES).contains(&usize::from(count))
 }
 
 /// A piece of an 8-bit grey frame, rows top to bottom, packed (stride = width).
@@ -468,4 +488,38 @@ pub struct Measured {
     /// The silhouette agreement at the measured state (0..=1), when the tracker parameters
     /// ask for it (`silhouette_grid` > 0) and it can be scored.
     pub silhouette: Option<f32>,
+}
+
+/// One hypothesis the board carries (version 5).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WireHypothesis {
+    /// Its likelihood score on the frame, less the lost penalty (likelihood units, at most 1;
+    /// `hypotheses::Hypothesis::score`).
+    pub score: f32,
+    /// Frames it has been carried (0: sampled on this frame).
+    pub age: u32,
+    /// Its state: every model state (quaternion, mm, rad).
+    pub q: Vec<f32, MAX_STATES>,
+}
+
+impl From<&Hypothesis> for WireHypothesis {
+    fn from(h: &Hypothesis) -> Self {
+        WireHypothesis {
+            score: h.score,
+            age: h.age,
+            q: h.memory.state.clone(),
+        }
+    }
+}
+
+/// The hypotheses carried after one frame, best first (version 5): the first is the `State`'s
+/// `q`. Empty on a frame whose status is `Searching` (no hand is claimed, so none is carried).
+/// At most [`MAX_HYPOTHESES`] × [`MAX_STATES`] states: 1,122 bytes encoded at most, within
+/// [`MAX_MESSAGE`](super::MAX_MESSAGE).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Hypotheses {
+    /// The frame, as in its `State`.
+    pub frame: u32,
+    /// Best first.
+    pub hypotheses: Vec<WireHypothesis, MAX_HYPOTHESES>,
 }

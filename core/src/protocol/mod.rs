@@ -30,7 +30,10 @@ pub use params::{BadParameter, CameraParams, TrackerParams, WireResidual, WireRo
 /// Version 4: the board finds the hand itself: `State` gained `status` and
 /// `search_evaluations`, `Reset` gained `start` (from the given state, or search), `Configure`
 /// gained `search_evaluations_per_frame` (docs/protocol.md §10).
-pub const PROTOCOL_VERSION: u8 = 4;
+/// Version 5: several hypotheses: `Configure` gained `hypotheses` (the count K), and the board
+/// sends `Hypotheses` (board message 10) after every `State` when K > 1 (docs/protocol.md
+/// §11).
+pub const PROTOCOL_VERSION: u8 = 5;
 
 /// Largest `FrameChunk` payload (bytes).
 pub const MAX_CHUNK: usize = 1024;
@@ -38,8 +41,10 @@ pub const MAX_CHUNK: usize = 1024;
 /// Largest encoded message either side sends or accepts (bytes, both zero delimiters
 /// included: at most `MAX_MESSAGE − 2` COBS bytes between them), so the size of every receive
 /// and transmit buffer: the largest are a `Features` naming all
-/// [`MAX_LINKS`](crate::config::MAX_LINKS) links (1,315 bytes) and a full `FrameChunk`
-/// (about 1,050 bytes); `tests/protocol.rs` checks both fit.
+/// [`MAX_LINKS`](crate::config::MAX_LINKS) links (1,315 bytes), a `Hypotheses` of
+/// [`MAX_HYPOTHESES`](crate::config::MAX_HYPOTHESES) states of
+/// [`MAX_STATES`](crate::config::MAX_STATES) (1,122 bytes) and a full `FrameChunk` (about
+/// 1,050 bytes); `tests/protocol.rs` checks they fit.
 pub const MAX_MESSAGE: usize = 1408;
 
 /// The CRC of every frame: CRC-32/ISO-HDLC (the zlib/Ethernet CRC-32).

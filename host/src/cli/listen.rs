@@ -18,7 +18,9 @@ use crate::stream::DEFAULT_BAUD;
 /// Decodes every message on the serial port and prints one line each: text by default,
 /// JSON with --json (e.g. {"State":{"frame":12,"timestamp":…,"q":[…],"rms_px":…,…,
 /// "status":"Tracking",…}}). Each state's line names the board's status (searching,
-/// tracking or lost); the summary on stderr counts them.
+/// tracking or lost); the summary on stderr counts them. A board tracking several
+/// hypotheses follows each state with its hypotheses (their scores and ages, best first);
+/// the summary counts how many were carried on average.
 /// With --forward, messages also go to the machines that show the hand, as JSON lines
 /// (udp://) or Open Sound Control (osc://: /digiteyes/state, /digiteyes/q/N,
 /// /digiteyes/mouse, /digiteyes/dropped, /digiteyes/stats; see docs/forwarding.md).
@@ -127,9 +129,16 @@ pub fn run(args: ListenArgs) -> Result<()> {
     eprintln!("listening on {}", port.port);
     let summary = listen(link, &options, &mut std::io::stdout().lock())?;
     let [searching, tracking, lost] = summary.statuses;
+    let hypotheses = match summary.hypotheses_messages {
+        0 => String::new(),
+        n => format!(
+            "; {n} hypotheses messages, {:.2} carried on average",
+            summary.hypotheses_carried as f64 / n as f64
+        ),
+    };
     eprintln!(
-        "{} messages ({} states: {tracking} tracking, {lost} lost, {searching} searching), {} \
-         forwarded; {} CRC errors, {} framing errors",
+        "{} messages ({} states: {tracking} tracking, {lost} lost, {searching} \
+         searching{hypotheses}), {} forwarded; {} CRC errors, {} framing errors",
         summary.messages,
         summary.states,
         summary.forwarded,

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
+use digiteyes_core::config::MAX_HYPOTHESES;
 use digiteyes_core::protocol::{Start, TrackerParams};
 
 use super::tracker_config;
@@ -79,6 +80,12 @@ pub struct StreamArgs {
     /// tracking frame's; the search then takes more frames.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
     pub search_evaluations: Option<u16>,
+    /// Hypotheses the board's tracker carries, 1 to 8 (default: the tracker's). 1 is the
+    /// single tracker; with more the board sends them after every state (protocol version
+    /// 5) and the summary counts them (carried on average, the best's mean score). A single
+    /// board only: with one board per camera the host tracks.
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u8).range(1..=MAX_HYPOTHESES as i64))]
+    pub hypotheses: Option<u8>,
     /// Output CSV path (default: states.csv in the current folder).
     #[arg(long, short, default_value = "states.csv", hide_default_value = true)]
     pub out: PathBuf,
@@ -144,6 +151,13 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
                  initial_state only (accepted: --init given); a single board searches itself"
             );
         }
+        if args.hypotheses.is_some() {
+            bail!(
+                "--hypotheses: with one board per camera the host tracks, and its stereo \
+                 tracker carries one hypothesis; leave --hypotheses out, or stream one camera \
+                 to one board (--camera-index)"
+            );
+        }
         if args.camera_index.is_some() {
             bail!("--camera-index picks the one camera of a single board; with one --port per camera leave it out");
         }
@@ -169,6 +183,9 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
     options.tracker = tracker;
     if let Some(n) = args.search_evaluations {
         options.search_evaluations_per_frame = n;
+    }
+    if let Some(k) = args.hypotheses {
+        options.hypotheses = k;
     }
     let summary = match (args.seq, args.camera, args.setup) {
         (Some(seq), None, _) => stream_sequence(&seq, &args.out, &options)?,

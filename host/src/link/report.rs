@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 use std::fmt;
 
-use digiteyes_core::protocol::{LinkCounters, Stats};
+use digiteyes_core::protocol::{Hypotheses, LinkCounters, Stats};
 
 use super::outcome::{cause_key, FrameOutcome};
 
@@ -24,6 +24,14 @@ pub struct LinkReport {
     pub late_answers: usize,
     /// `Features` messages received.
     pub features: usize,
+    /// `Hypotheses` messages received (one per frame from a board with several hypotheses).
+    pub hypotheses_messages: usize,
+    /// The hypotheses they carried, summed (their mean is [`LinkReport::mean_hypotheses`]).
+    pub hypotheses_carried: usize,
+    /// The best hypothesis' score, summed over the messages that carried any.
+    pub best_score_sum: f64,
+    /// Messages that carried any hypothesis (none while the board searches).
+    pub hypotheses_nonempty: usize,
     /// Board reboots seen (unsolicited `Hello`s).
     pub restarts: usize,
     /// Seconds from the end of the set-up to the end of the session.
@@ -49,6 +57,22 @@ impl LinkReport {
     /// Tracked frames per second of session time.
     pub fn states_per_second(&self) -> f64 {
         self.tracked as f64 / self.seconds.max(1e-9)
+    }
+
+    /// Mean hypotheses carried per `Hypotheses` message; `None` without any.
+    pub fn mean_hypotheses(&self) -> Option<f64> {
+        (self.hypotheses_messages > 0)
+            .then(|| self.hypotheses_carried as f64 / self.hypotheses_messages as f64)
+    }
+
+    /// Counts one `Hypotheses` message.
+    pub(crate) fn count_hypotheses(&mut self, message: &Hypotheses) {
+        self.hypotheses_messages += 1;
+        self.hypotheses_carried += message.hypotheses.len();
+        if let Some(best) = message.hypotheses.first() {
+            self.hypotheses_nonempty += 1;
+            self.best_score_sum += f64::from(best.score);
+        }
     }
 
     pub(crate) fn count(&mut self, outcome: &FrameOutcome) {
@@ -94,6 +118,15 @@ impl fmt::Display for LinkReport {
             self.bytes_up as f64 / seconds / 1000.0,
             self.bytes_down
         )?;
+        if let Some(mean) = self.mean_hypotheses() {
+            writeln!(
+                f,
+                "  hypotheses: {} messages, {mean:.2} carried on average (best's mean score \
+                 {:.3})",
+                self.hypotheses_messages,
+                self.best_score_sum / self.hypotheses_nonempty.max(1) as f64
+            )?;
+        }
         writeln!(
             f,
             "  host receiver: {}; {} late answers, {} board restart(s)",

@@ -276,6 +276,9 @@ impl Session {
             BoardMessage::Stats(stats) => self.report.board = Some(stats),
             BoardMessage::State(_) | BoardMessage::Dropped(_) => self.report.late_answers += 1,
             BoardMessage::Features(_) => self.report.features += 1,
+            // They follow their frame's State, so they arrive while the next frame (or the
+            // final ping) is awaited.
+            BoardMessage::Hypotheses(h) => self.report.count_hypotheses(&h),
             BoardMessage::LinkEdges(_) | BoardMessage::Measured(_) => self.report.late_answers += 1,
             BoardMessage::Hello(hello) => {
                 self.check_hello(&hello)?;
@@ -297,6 +300,7 @@ impl Session {
             features_every: self.setup.features_every,
             stats_every: self.setup.stats_every,
             search_evaluations_per_frame: self.setup.search_evaluations_per_frame,
+            hypotheses: self.setup.hypotheses,
         });
         self.command(&configure, Command::Configure)?;
         let q: HVec<f32, MAX_STATES> = q.iter().copied().take(MAX_STATES).collect();
@@ -381,7 +385,10 @@ impl Session {
 fn refusal_text(refusal: Refusal) -> &'static str {
     match refusal {
         Refusal::BadCamera => "the camera is unusable (size or focal length)",
-        Refusal::BadParameters => "a tracker parameter is out of range, or the search budget is 0",
+        Refusal::BadParameters => {
+            "a tracker parameter is out of range, the search budget is 0, or the hypothesis \
+             count is not 1 to 8"
+        }
         Refusal::FrameTooLarge => {
             "the camera's frames (or their edge map for the search) do not fit the board's \
              buffers"

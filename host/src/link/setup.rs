@@ -5,7 +5,8 @@ use std::time::Duration;
 
 use anyhow::{anyhow, bail, Result};
 use digiteyes_core::protocol::{
-    default_search_evaluations, model_digest, CameraParams, Start, TrackerParams,
+    default_hypotheses, default_search_evaluations, model_digest, CameraParams, Start,
+    TrackerParams,
 };
 
 use crate::sequence::Sequence;
@@ -33,6 +34,9 @@ pub struct SessionSetup {
     pub start: Start,
     /// The board's search budget per frame, in evaluations (`Configure`).
     pub search_evaluations_per_frame: u16,
+    /// Hypotheses the board's tracker carries, 1..=8 (`Configure`; protocol version 5): more
+    /// than 1 makes it send a `Hypotheses` message after every `State`.
+    pub hypotheses: u8,
     /// [`model_digest`] of the model the frames show; the board's must match.
     pub model_digest: u32,
     /// The model's name for messages (`sequence.json`'s `model`).
@@ -88,6 +92,7 @@ impl SessionSetup {
                 Start::Search
             },
             search_evaluations_per_frame: default_search_evaluations(),
+            hypotheses: default_hypotheses(),
             model_digest: model_digest(&sequence.model),
             model_name: sequence.file.model.clone(),
             reply_timeout: DEFAULT_REPLY_TIMEOUT,

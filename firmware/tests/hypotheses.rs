@@ -1,0 +1,260 @@
+//! Several hypotheses on the board (protocol version 5): `Configure` sets the count K; a board
+//! with K > 1 answers each frame with its `State` and then a `Hypotheses` message, and both
+//! are bit-equal to an in-process `AutoTracker` with the same K on the same frames of a
+//! rendered whole hand; K = 1 sends no `Hypotheses`; K = 0 or more than `MAX_HYPOTHESES` is
+//! refused; a `Configure` that changes only K applies it from the next frame.
+
+mod common;
+
+use common::*;
+use digiteyes_core::auto_tracker::AutoTracker;
+use digiteyes_core::config::MAX_HYPOTHESES;
+use digiteyes_core::estimator::FreeMask;
+use digiteyes_core::frame::FrameView;
+use digiteyes_core::model::Model;
+use digiteyes_core::protocol::*;
+use digiteyes_core::status::Status;
+use digiteyes_firmware::{edge_map_bytes, hypotheses_config, search_config};
+
+const FRAME_BYTES: usize = (WIDTH * HEIGHT) as usize;
+
+/// Every state of the whole hand is estimated.
+fn free_all(model: &Model) -> u32 {
+    (0..model.n_states()).map(|s| 1u32 << s).sum()
+}
+
+fn configure(hypotheses: u8) -> HostMessage<'static> {
+    HostMessage::Configure(Configure {
+        camera: CameraParams::from_camera(&camera()).unwrap(),
+        tracker: TrackerParams::default(),
+        features_every: 0,
+        stats_every: 0,
+        search_evaluations_per_frame: default_search_evaluations(),
+        hypotheses,
+    })
+}
+
+/// A board after boot, `Configure` with `k` hypotheses and `Reset` tracking from `q0`.
+fn started<'m>(buffer: &'m mut [u8], k: u8, q0: &[f32], free: u32) -> TestBoard<'m> {
+    let mut board = test_board("hypotheses", buffer);
+    board.start().unwrap();
+    board.serial_mut().send(&configure(k));
+    board.serial_mut().send(&HostMessage::Reset(Reset {
+        q: q0.iter().copied().collect(),
+        free,
+        start: Start::Given,
+    }));
+    board.poll().unwrap();
+    let replies = board.serial_mut().received();
+    assert!(
+        replies.contains(&BoardMessage::Ack(Command::Configure))
+            && replies.ends_with(&[BoardMessage::Ack(Command::Reset)]),
+        "{replies:?}"
+    );
+    board
+}
+
+/// The bits of a list of floats, so NaN and −0 compare exactly.
+fn bits(values: &[f32]) -> Vec<u32> {
+    values.iter().map(|v| v.to_bits()).collect()
+}
+
+/// A hypothesis as bits: score, age, state.
+fn hypothesis_bits(h: &WireHypothesis) -> (u32, u32, Vec<u32>) {
+    (h.score.to_bits(), h.age, bits(&h.q))
+}
+
+/// The whole hand, fingers bending a little more each frame, rendered at 160×120.
+fn sequence(model: &Model) -> Vec<Vec<u8>> {
+    let cam = camera();
+    [0.22f32, 0.26, 0.31, 0.37, 0.44, 0.52]
+        .iter()
+        .map(|&bend| render(model, &cam, &pose(model, bend)))
+        .collect()
+}
+
+/// The board with `k` hypotheses against `AutoTracker` in process with the same `k`: every
+/// frame's `State` (state, status, report) and `Hypotheses` (scores, ages, states, best
+/// first) bit-equal. Returns the most hypotheses any frame carried.
+fn board_matches_in_process(k: u8) -> usize {
+    let model = Model::hand().unwrap();
+    let q0 = pose(&model, 0.2);
+    let free = free_all(&model);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = started(&mut buffer, k, &q0, free);
+    let tracker = TrackerParams::default().to_config().unwrap();
+    let mut reference = AutoTracker::tracking(
+        model.clone(),
+        &[camera()],
+        &q0,
+        FreeMask(free),
+        tracker,
+        search_config(default_search_evaluations()),
+    )
+    .unwrap();
+    reference.set_hypotheses(hypotheses_config(k));
+    let mut edges = vec![0u8; edge_map_bytes(WIDTH as usize, HEIGHT as usize)];
+    let mut most = 0;
+    for (n, pixels) in sequence(&model).iter().enumerate() {
+        let n = n as u32;
+        board
+            .serial_mut()
+            .send_frame(n, WIDTH as u16, HEIGHT as u16, pixels);
+        board.poll().unwrap();
+        let view = FrameView::packed(pixels, WIDTH as usize, HEIGHT as usize).unwrap();
+        let expected = reference.step(&[view], &mut [&mut edges[..]]).unwrap();
+        let (state, hypotheses) = match &board.serial_mut().received()[..] {
+            [BoardMessage::State(s), BoardMessage::Hypotheses(h)] => (s.clone(), h.clone()),
+            other => panic!("K = {k}, frame {n}: a State then Hypotheses expected, got {other:?}"),
+        };
+        assert_eq!((state.frame, hypotheses.frame), (n, n));
+        assert_eq!(
+            bits(&state.q),
+            bits(reference.state()),
+            "K = {k}, frame {n}"
+        );
+        assert_eq!(
+            Status::from(state.status),
+            expected.status,
+            "K = {k}, frame {n}"
+        );
+        assert_eq!(
+            (
+                state.rms_px.to_bits(),
+                state.iterations,
+                state.features_found,
+                state.features_expected
+            ),
+            (
+                expected.report.rms_px.to_bits(),
+                expected.report.iterations,
+                expected.report.features_found,
+                expected.report.features_expected
+            ),
+            "K = {k}, frame {n}"
+        );
+        let want: Vec<_> = reference
+            .hypotheses()
+            .iter()
+            .map(|h| hypothesis_bits(&WireHypothesis::from(h)))
+            .collect();
+        let got: Vec<_> = hypotheses.hypotheses.iter().map(hypothesis_bits).collect();
+        assert_eq!(got, want, "K = {k}, frame {n}: the hypotheses");
+        assert_eq!(
+            got.len(),
+            usize::from(expected.hypotheses),
+            "K = {k}, frame {n}"
+        );
+        assert!(got.len() <= usize::from(k));
+        // The best hypothesis is the state reported.
+        assert_eq!(got[0].2, bits(&state.q), "K = {k}, frame {n}: best first");
+        most = most.max(got.len());
+    }
+    most
+}
+
+#[test]
+fn a_board_with_two_hypotheses_is_bit_equal_to_the_tracker_in_process() {
+    let most = board_matches_in_process(2);
+    assert_eq!(most, 2, "two hypotheses were carried on some frame");
+}
+
+#[test]
+fn a_board_with_four_hypotheses_is_bit_equal_to_the_tracker_in_process() {
+    let most = board_matches_in_process(4);
+    assert!(most >= 2, "several hypotheses were carried: at most {most}");
+}
+
+#[test]
+fn one_hypothesis_sends_no_hypotheses_message() {
+    let model = Model::hand().unwrap();
+    let q0 = pose(&model, 0.2);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = started(&mut buffer, 1, &q0, free_all(&model));
+    let pixels = render(&model, &camera(), &pose(&model, 0.22));
+    board
+        .serial_mut()
+        .send_frame(0, WIDTH as u16, HEIGHT as u16, &pixels);
+    board.poll().unwrap();
+    assert!(matches!(
+        &board.serial_mut().received()[..],
+        [BoardMessage::State(s)] if s.status == WireStatus::Tracking
+    ));
+}
+
+#[test]
+fn configure_refuses_zero_hypotheses_and_more_than_the_capacity() {
+    for k in [0u8, MAX_HYPOTHESES as u8 + 1, u8::MAX] {
+        let mut buffer = vec![0u8; FRAME_BYTES];
+        let mut board = test_board("hypotheses", &mut buffer);
+        board.start().unwrap();
+        board.serial_mut().send(&configure(k));
+        board.poll().unwrap();
+        assert!(
+            board.serial_mut().received().ends_with(&[BoardMessage::Nak(
+                Command::Configure,
+                Refusal::BadParameters
+            )]),
+            "K = {k}"
+        );
+        // Refused: the board has no camera, so a Reset is refused too.
+        board.serial_mut().send(&HostMessage::Reset(Reset {
+            q: pose(&Model::hand().unwrap(), 0.2).into_iter().collect(),
+            free: 0,
+            start: Start::Given,
+        }));
+        board.poll().unwrap();
+        assert_eq!(
+            board.serial_mut().received(),
+            [BoardMessage::Nak(Command::Reset, Refusal::NotConfigured)],
+            "K = {k}"
+        );
+    }
+    // The largest count is taken.
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = test_board("hypotheses", &mut buffer);
+    board.start().unwrap();
+    board.serial_mut().send(&configure(MAX_HYPOTHESES as u8));
+    board.poll().unwrap();
+    assert!(board
+        .serial_mut()
+        .received()
+        .ends_with(&[BoardMessage::Ack(Command::Configure)]));
+}
+
+/// A `Configure` that changes only K keeps the board tracking (status, state, motion) and
+/// applies the new count from the next frame: the `Hypotheses` message starts, and stops
+/// again when K returns to 1.
+#[test]
+fn a_configure_changing_only_the_count_applies_it_from_the_next_frame() {
+    let model = Model::hand().unwrap();
+    let q0 = pose(&model, 0.2);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = started(&mut buffer, 1, &q0, free_all(&model));
+    let frames = sequence(&model);
+    let mut kinds = Vec::new();
+    for (n, (pixels, k)) in frames.iter().zip([1u8, 3, 3, 1]).enumerate() {
+        board.serial_mut().send(&configure(k));
+        board
+            .serial_mut()
+            .send_frame(n as u32, WIDTH as u16, HEIGHT as u16, pixels);
+        board.poll().unwrap();
+        let replies = board.serial_mut().received();
+        assert_eq!(replies[0], BoardMessage::Ack(Command::Configure));
+        let BoardMessage::State(state) = &replies[1] else {
+            panic!("frame {n}: {replies:?}")
+        };
+        assert_eq!(state.status, WireStatus::Tracking, "frame {n}");
+        kinds.push(match &replies[2..] {
+            [] => 0,
+            [BoardMessage::Hypotheses(h)] => {
+                assert!(!h.hypotheses.is_empty() && h.hypotheses.len() <= usize::from(k));
+                h.hypotheses.len()
+            }
+            other => panic!("frame {n}: {other:?}"),
+        });
+    }
+    assert_eq!(kinds[0], 0, "K = 1: no Hypotheses");
+    assert!(kinds[1] >= 1 && kinds[2] >= 1, "K = 3: Hypotheses follow");
+    assert_eq!(kinds[3], 0, "K = 1 again: none");
+}

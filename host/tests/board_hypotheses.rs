@@ -1,0 +1,229 @@
+//! Several hypotheses on a board through the `digiteyes` command (protocol version 5):
+//! `stream --hypotheses K` has a simulated board (the firmware's loop) carry K hypotheses and
+//! the summary count the `Hypotheses` messages that follow its states; `listen` prints each
+//! one and counts them; a count out of 1..=8, or with one board per camera, is refused clearly.
+
+mod common;
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::process::{Command, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use digiteyes_core::protocol::{
+    encode, BoardMessage, Hypotheses, State, WireHypothesis, WireStatus, MAX_MESSAGE,
+};
+use digiteyes_host::sim::{self, SimOptions};
+use serialport::{SerialPort, TTYPort};
+
+/// Kills and reaps a child process when dropped, so a failing test leaves none behind.
+struct Reap(std::process::Child);
+
+impl Drop for Reap {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// `stream --hypotheses 3` on a whole-hand sequence: every tracked frame's state is followed
+/// by its hypotheses (one message each, 1 to 3 carried), which the summary counts; without
+/// the option (one hypothesis) no such message comes and the summary has no such line.
+#[test]
+fn stream_with_hypotheses_counts_what_the_board_carried() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = 4;
+    common::small_sequence(dir.path(), "fullhand-mono", frames);
+    let run = |extra: &[&str], csv: &str| {
+        let board = sim::start(SimOptions::default()).unwrap();
+        let port = board.path().display().to_string();
+        let out = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
+            .args(["stream", "--port", &port, "--seq", "fullhand-mono"])
+            .args(extra)
+            .args(["--out", csv, "--quiet"])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        let report = board.stop().unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            out.status.success(),
+            "{stdout}\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_eq!(report.board.frames, frames as u32, "{report:?}");
+        stdout
+    };
+    let stdout = run(&["--hypotheses", "3"], "k3.csv");
+    assert!(stdout.contains(&format!("{frames} tracked")), "{stdout}");
+    let line = stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("hypotheses: "))
+        .unwrap_or_else(|| panic!("a hypotheses line: {stdout}"));
+    // "  hypotheses: 4 messages, 2.50 carried on average (best's mean score 0.850)"
+    let words: Vec<&str> = line.split_whitespace().collect();
+    assert_eq!(
+        words[1],
+        frames.to_string(),
+        "one message per frame: {line}"
+    );
+    let mean: f64 = words[3].parse().unwrap();
+    assert!((1.0..=3.0).contains(&mean), "{line}");
+    assert!(
+        mean > 1.0,
+        "a whole hand carries more than one hypothesis: {line}"
+    );
+    assert!(line.contains("best's mean score 0."), "{line}");
+
+    let single = run(&["--hypotheses", "1"], "k1.csv");
+    assert!(
+        !single.contains("hypotheses:"),
+        "one hypothesis, no such message: {single}"
+    );
+}
+
+fn state(frame: u32) -> BoardMessage {
+    BoardMessage::State(State {
+        frame,
+        timestamp: 1000 * u64::from(frame),
+        q: [1.0, 0.0, 0.0, 0.0, 1.5, -2.0, 600.0].into_iter().collect(),
+        rms_px: 0.5,
+        lost: false,
+        features_found: 20,
+        features_expected: 24,
+        iterations: 5,
+        track_ticks: 1234,
+        status: WireStatus::Tracking,
+        search_evaluations: 0,
+    })
+}
+
+fn hypotheses(frame: u32, scores: &[f32]) -> BoardMessage {
+    BoardMessage::Hypotheses(Hypotheses {
+        frame,
+        hypotheses: scores
+            .iter()
+            .enumerate()
+            .map(|(i, &score)| WireHypothesis {
+                score,
+                age: 10 - i as u32,
+                q: [1.0, 0.0, 0.0, 0.0, 1.5, -2.0, 600.0 + i as f32]
+                    .into_iter()
+                    .collect(),
+            })
+            .collect(),
+    })
+}
+
+#[test]
+fn listen_prints_each_hypotheses_message_and_counts_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut board, slave) = TTYPort::pair().unwrap();
+    let path = slave.name().unwrap();
+    let mut listen = Reap(
+        Command::new(env!("CARGO_BIN_EXE_digiteyes"))
+            .args(["listen", "--port", &path, "--states", "3"])
+            .current_dir(dir.path())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap(),
+    );
+    let (tx, rx) = mpsc::channel();
+    let stderr = listen.0.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+    let opened = rx.recv_timeout(Duration::from_secs(30)).unwrap();
+    assert!(opened.contains("listening on"), "{opened}");
+
+    // Two frames with their hypotheses (3, then 1), then a third state: listen stops there.
+    let mut bytes = Vec::new();
+    for message in [
+        state(7),
+        hypotheses(7, &[0.9, 0.875, 0.5]),
+        state(8),
+        hypotheses(8, &[0.75]),
+        state(9),
+    ] {
+        let mut buf = [0u8; MAX_MESSAGE];
+        bytes.extend_from_slice(encode(&message, &mut buf).unwrap());
+    }
+    board.write_all(&bytes).unwrap();
+
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while listen.0.try_wait().unwrap().is_none() {
+        assert!(
+            Instant::now() < deadline,
+            "listen did not stop after 3 states"
+        );
+        // Polling for the child's exit, which it reaches by itself after three states.
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert!(listen.0.wait().unwrap().success());
+    let mut printed = String::new();
+    listen
+        .0
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut printed)
+        .unwrap();
+    reader.join().unwrap();
+    let summary: Vec<String> = rx.try_iter().collect();
+    let lines: Vec<&str> = printed.lines().collect();
+    assert_eq!(lines.len(), 5, "{printed}");
+    assert_eq!(
+        lines[1],
+        "hypotheses 7: 3 carried, best first: 0.9000 (age 10), 0.8750 (age 9), 0.5000 (age 8)"
+    );
+    assert_eq!(
+        lines[3],
+        "hypotheses 8: 1 carried, best first: 0.7500 (age 10)"
+    );
+    assert!(
+        summary
+            .iter()
+            .any(|l| l.contains("2 hypotheses messages, 2.00 carried on average")),
+        "{summary:?}"
+    );
+}
+
+#[test]
+fn a_hypothesis_count_out_of_range_or_with_a_board_per_camera_is_refused_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    for k in ["0", "9"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
+            .args(["stream", "--port", "/nonexistent/a", "--seq", "mono"])
+            .args(["--hypotheses", k])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(
+            stderr.contains("--hypotheses") && stderr.contains("1..=8"),
+            "K = {k}: {stderr}"
+        );
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
+        .args([
+            "stream",
+            "--port",
+            "/nonexistent/a",
+            "--port",
+            "/nonexistent/b",
+        ])
+        .args(["--seq", "stereo", "--hypotheses", "2"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("--hypotheses") && stderr.contains("one board per camera"),
+        "{stderr}"
+    );
+}
