@@ -8,7 +8,7 @@
 //!   refused the search starts over.
 //! - **Tracking**: the tracker runs — one hypothesis, or several ([`MultiTracker`], set by
 //!   [`AutoTracker::set_hypotheses`]); a lost frame makes the status [`Status::Lost`]. Every
-//!   few frames the [watch](crate::watch) scores the tracked state by the likelihood in every
+//!   few frames (eight at 320×240) the [watch](crate::watch) scores the tracked state by the likelihood in every
 //!   camera; a state some camera does not support is a lost frame too, and is checked again
 //!   on every frame until a check passes (not with [`Recovery::Never`], the plain tracker).
 //! - **Lost**: the tracker still runs (holding its last good state); a frame not lost makes it
@@ -148,6 +148,15 @@ struct Refined {
     report: FrameReport,
 }
 
+/// The pixels of the largest camera's frames.
+fn largest_frame_pixels(cameras: &[Camera]) -> usize {
+    cameras
+        .iter()
+        .map(|c| c.width as usize * c.height as usize)
+        .max()
+        .unwrap_or(0)
+}
+
 /// A tracker that finds the hand, tracks it, and finds it again.
 #[derive(Debug, Clone)]
 pub struct AutoTracker {
@@ -199,7 +208,7 @@ impl AutoTracker {
             local_left: 0,
             following: None,
             recovery: Recovery::Search,
-            watch: Watch::new(WatchConfig::default()),
+            watch: Watch::new(WatchConfig::default(), largest_frame_pixels(cameras)),
             vouched: heapless::Vec::new(),
         })
     }
@@ -243,7 +252,7 @@ impl AutoTracker {
 
     /// Sets how the image checks the track ([`crate::watch`]; `every_frames` 0: never).
     pub fn set_watch(&mut self, config: WatchConfig) {
-        self.watch = Watch::new(config);
+        self.watch = Watch::new(config, largest_frame_pixels(self.multi.tracker().cameras()));
     }
 
     /// Sets what happens once the hand is lost for [`LOST_FRAMES_BEFORE_SEARCH`] frames.

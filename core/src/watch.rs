@@ -7,9 +7,11 @@
 //! scores the whole projected model — oriented chamfer along every silhouette line and the
 //! region's agreement — so such a track scores low.
 //!
-//! The bar is relative: the first frame of a track (started from a given state, or just
-//! acquired) sets the *reference*, and a later check fails when the worst camera scores more
-//! than [`WatchConfig::max_drop`] under it. The score's scale depends on the images (contrast,
+//! The bar is relative: the first frame checked (the given initial state's, or the first
+//! acquisition's) sets the *reference*, and a later check fails when the worst camera scores
+//! more than [`WatchConfig::max_drop`] under it. The reference is kept through losses and
+//! re-acquisitions: the scene's scale does not change, and a wrong re-acquisition must not
+//! set its own bar. The score's scale depends on the images (contrast,
 //! edges, renderer): a right track of the independent renderer's `sample-mouse` fixture scores
 //! 0.80–0.88, of our own random rigs 0.89–0.97, so no fixed bar fits both. Measured on the
 //! robustness sweep's rigs (seeds 61–80, 640×480, 200 frames, `host/examples/watch_study.rs`):
@@ -18,12 +20,19 @@
 //!
 //! While a check fails the track is *in doubt*: every frame is checked until one passes.
 
+/// The frame size (px) at which a check falls due every [`WatchConfig::every_frames`]
+/// frames: 320×240.
+pub const WATCH_REFERENCE_PIXELS: usize = 320 * 240;
+
 /// When and how strictly the track is checked.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct WatchConfig {
-    /// A tracking frame is checked once every this many (0: never checked). The check builds
-    /// each camera's edge map, so it costs about that frame's tracking again.
+    /// A tracking frame of [`WATCH_REFERENCE_PIXELS`] is checked once every this many
+    /// (0: never checked); larger frames proportionally less often. The check builds each
+    /// camera's edge map, whose cost grows with the pixels while a tracking frame's does not:
+    /// at 320×240 a check costs about 1.5 whole-hand tracking frames, at 640×480 about 6
+    /// (docs/performance.md), so the period keeps the watch near a fifth of the tracking.
     pub every_frames: u8,
     /// How far (likelihood units, 0..=1) the worst camera's score may fall under the
     /// track's reference.
@@ -33,7 +42,7 @@ pub struct WatchConfig {
 impl Default for WatchConfig {
     fn default() -> Self {
         WatchConfig {
-            every_frames: 4,
+            every_frames: 8,
             max_drop: 0.10,
         }
     }
@@ -44,8 +53,10 @@ impl Default for WatchConfig {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Watch {
     config: WatchConfig,
+    /// A check every this many tracking frames (0: never).
+    period_frames: u16,
     /// Tracking frames since the last check.
-    since_check: u8,
+    since_check: u16,
     /// The last check failed.
     doubted: bool,
     /// The worst camera's score on the track's first checked frame.
@@ -53,10 +64,14 @@ pub struct Watch {
 }
 
 impl Watch {
-    /// A watch that checks as `config` says.
-    pub fn new(config: WatchConfig) -> Self {
+    /// A watch that checks as `config` says, on frames of `pixels` pixels (the largest
+    /// camera's).
+    pub fn new(config: WatchConfig, pixels: usize) -> Self {
+        let scale = pixels.div_ceil(WATCH_REFERENCE_PIXELS).max(1);
+        let period = usize::from(config.every_frames).saturating_mul(scale);
         Watch {
             config,
+            period_frames: u16::try_from(period).unwrap_or(u16::MAX),
             since_check: 0,
             doubted: false,
             reference: None,
@@ -68,13 +83,18 @@ impl Watch {
         &self.config
     }
 
+    /// A check falls due every this many tracking frames (0: never).
+    pub fn period_frames(&self) -> u16 {
+        self.period_frames
+    }
+
     /// Whether this tracking frame is to be checked (and counts it).
     pub fn due(&mut self) -> bool {
-        if self.config.every_frames == 0 {
+        if self.period_frames == 0 {
             return false;
         }
         self.since_check = self.since_check.saturating_add(1);
-        self.doubted || self.reference.is_none() || self.since_check >= self.config.every_frames
+        self.doubted || self.reference.is_none() || self.since_check >= self.period_frames
     }
 
     /// The track's reference score, once its first frame has been checked.
@@ -98,11 +118,10 @@ impl Watch {
         passed
     }
 
-    /// Forgets the doubt and the reference (a new track starts: acquired or reset).
+    /// Forgets the doubt (the hand was acquired again); the reference is kept.
     pub fn clear(&mut self) {
         self.since_check = 0;
         self.doubted = false;
-        self.reference = None;
     }
 
     /// The last check failed and no check has passed since.
@@ -116,10 +135,22 @@ mod tests {
     use super::*;
 
     fn every(n: u8) -> Watch {
-        Watch::new(WatchConfig {
-            every_frames: n,
-            max_drop: 0.1,
-        })
+        Watch::new(
+            WatchConfig {
+                every_frames: n,
+                max_drop: 0.1,
+            },
+            WATCH_REFERENCE_PIXELS,
+        )
+    }
+
+    #[test]
+    fn larger_frames_are_checked_proportionally_less_often() {
+        let config = WatchConfig::default();
+        assert_eq!(Watch::new(config, 160 * 120).period_frames(), 8);
+        assert_eq!(Watch::new(config, 320 * 240).period_frames(), 8);
+        assert_eq!(Watch::new(config, 640 * 480).period_frames(), 32);
+        assert_eq!(Watch::new(config, usize::MAX).period_frames(), u16::MAX);
     }
 
     #[test]
@@ -151,15 +182,16 @@ mod tests {
     }
 
     #[test]
-    fn clearing_forgets_the_reference_and_the_doubt() {
+    fn clearing_forgets_the_doubt_and_keeps_the_reference() {
         let mut w = every(4);
         assert!(w.due() && w.judge(0.95));
         w.due();
         assert!(!w.judge(0.5));
         w.clear();
-        assert!(!w.doubted() && w.reference().is_none());
-        assert!(w.due() && w.judge(0.6));
-        assert_eq!(w.reference(), Some(0.6));
+        assert!(!w.doubted() && !w.due());
+        assert_eq!(w.reference(), Some(0.95));
+        assert!(!w.due() && !w.due() && w.due());
+        assert!(!w.judge(0.6));
     }
 
     #[test]

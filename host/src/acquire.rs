@@ -14,6 +14,7 @@ use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::HypothesesConfig;
 use digiteyes_core::model::Model;
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
+use digiteyes_core::watch::WatchConfig;
 
 /// A tracker that finds the hand, tracks it, and finds it again, with its buffers.
 pub struct AutoTracker {
@@ -71,6 +72,11 @@ impl AutoTracker {
     /// Sets the thresholds a refined leaf needs to be accepted.
     pub fn set_accept(&mut self, accept: AcceptConfig) {
         self.inner.set_accept(accept);
+    }
+
+    /// Sets how the image checks the track (`every_frames` 0: never).
+    pub fn set_watch(&mut self, config: WatchConfig) {
+        self.inner.set_watch(config);
     }
 
     /// Sets how many hypotheses are tracked (one: the single tracker, bit for bit).

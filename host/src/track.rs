@@ -26,6 +26,7 @@ use digiteyes_core::config::MAX_HYPOTHESES;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::HypothesesConfig;
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
+use digiteyes_core::watch::WatchConfig;
 
 use crate::acquire::{AutoTracker, Recovery, Status};
 use crate::overlay::{draw_overlay, overlay_path, PngStats, PngWriter};
@@ -68,6 +69,9 @@ pub struct TrackOptions {
     /// Their likelihood's edge-map stride is taken from [`TrackOptions::acquire`], whose
     /// buffers they share.
     pub hypotheses: HypothesesConfig,
+    /// How the image checks the track ([`digiteyes_core::watch`]; not with
+    /// [`Recovery::Never`]).
+    pub watch: WatchConfig,
 }
 
 impl Default for TrackOptions {
@@ -77,6 +81,7 @@ impl Default for TrackOptions {
             recovery: Recovery::Search,
             acquire: AcquireConfig::default(),
             hypotheses: HypothesesConfig::default(),
+            watch: WatchConfig::default(),
         }
     }
 }
@@ -298,6 +303,7 @@ pub fn sequence_auto_tracker(
     }
     .with_context(|| format!("{name}"))?;
     auto.set_recovery(options.recovery);
+    auto.set_watch(options.watch);
     auto.set_hypotheses(hypotheses_config(options)?);
     Ok(auto)
 }

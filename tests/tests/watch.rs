@@ -1,0 +1,99 @@
+//! The image's check on the track (`core/src/watch.rs`, issue 9): a track the likelihood no
+//! longer supports is flagged lost even while its features and residual look healthy, and a
+//! right track is never flagged — also on the independent renderer's fixture, whose right
+//! track scores lower than ours (an absolute bar flagged its frames 3–6).
+
+use std::path::Path;
+
+use digiteyes_core::watch::WatchConfig;
+use digiteyes_host::sequence::read_states;
+use digiteyes_host::track::{track_sequence_opts, TrackOptions};
+use digiteyes_host::{evaluate, render_scenario, RenderOptions, TrackerConfig};
+
+fn never() -> WatchConfig {
+    WatchConfig {
+        every_frames: 0,
+        ..WatchConfig::default()
+    }
+}
+
+/// Tracks `seq` with `watch`; returns each frame's `lost` and mean fingertip error (px).
+fn track(seq: &Path, out: &Path, watch: WatchConfig) -> (Vec<bool>, Vec<f64>) {
+    let options = TrackOptions {
+        watch,
+        ..TrackOptions::default()
+    };
+    track_sequence_opts(seq, out, TrackerConfig::default(), false, None, &options).unwrap();
+    let report = evaluate(seq, out).unwrap();
+    let states = read_states(out, 28).unwrap();
+    let lost = states
+        .extra("lost")
+        .unwrap()
+        .iter()
+        .map(|&v| v != 0.0)
+        .collect();
+    (lost, report.fingertip_mean_by_frame)
+}
+
+#[test]
+fn a_right_track_of_another_renderer_is_never_flagged() {
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/sample-mouse");
+    let dir = tempfile::tempdir().unwrap();
+    let (lost, tips) = track(&fixture, &dir.path().join("a.csv"), WatchConfig::default());
+    let (plain, _) = track(&fixture, &dir.path().join("b.csv"), never());
+    assert!(
+        tips.iter().all(|&t| t < 3.0),
+        "the fixture is tracked: {tips:?}"
+    );
+    assert_eq!(lost, plain);
+    assert!(lost.iter().all(|&l| !l), "right frames flagged: {lost:?}");
+}
+
+#[test]
+fn a_track_the_image_no_longer_supports_is_flagged() {
+    // Seed 76 (a stereo rig of the robustness sweep, 640x480): from frame ~59 the track
+    // settles on wrong fingers while the tracker's own flag stays down. At 640x480 a check
+    // falls due every 32 frames, so the watch removes a third or more of those frames
+    // (measured: 30 -> 17), not all.
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("seq");
+    let options = RenderOptions {
+        seed: 76,
+        frames: Some(90),
+        supersample: 2,
+        ..RenderOptions::default()
+    };
+    render_scenario("random-stereo", &seq, &options).unwrap();
+    let wrong = 20.0; // px at 640 wide: the sweep's "truly lost"
+    let (watched, tips) = track(&seq, &dir.path().join("a.csv"), WatchConfig::default());
+    let (plain, plain_tips) = track(&seq, &dir.path().join("b.csv"), never());
+    let claimed_wrong = |lost: &[bool], tips: &[f64]| {
+        lost.iter()
+            .zip(tips)
+            .filter(|(l, t)| !**l && **t > wrong)
+            .count()
+    };
+    let right_flagged = |lost: &[bool], tips: &[f64]| {
+        lost.iter()
+            .zip(tips)
+            .filter(|(l, t)| **l && **t <= wrong)
+            .count()
+    };
+    let (with, without) = (
+        claimed_wrong(&watched, &tips),
+        claimed_wrong(&plain, &plain_tips),
+    );
+    assert!(
+        without >= 10,
+        "the plain track is claimed while wrong: {without} frames"
+    );
+    assert!(
+        with * 3 <= without * 2,
+        "frames claimed while wrong: {with} with the watch, {without} without"
+    );
+    assert_eq!(
+        right_flagged(&watched, &tips),
+        right_flagged(&plain, &plain_tips),
+        "the watch flagged right frames"
+    );
+}
