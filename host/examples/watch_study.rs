@@ -46,7 +46,7 @@ fn main() -> Result<()> {
 }
 
 fn study_seed(seed: u64, size: (u32, u32), frames: usize, dir: &Path) -> Result<()> {
-    let name = if seed % 2 == 0 {
+    let name = if seed.is_multiple_of(2) {
         "random-stereo"
     } else {
         "random-mono"
