@@ -13,8 +13,7 @@ use digiteyes_core::acquire::AcquireConfig;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::score::StateScorer;
 use digiteyes_core::likelihood::EdgeMap;
-use digiteyes_core::state::TRANSLATION;
-use digiteyes_host::bench::robustness::{TRULY_LOST_PALM_MM, TRULY_LOST_TIP_PX_AT_640};
+use digiteyes_host::bench::robustness::{judge_frame, TRULY_LOST_TIP_PX_AT_640};
 use digiteyes_host::scenarios::{render_scenario, RenderOptions};
 use digiteyes_host::sequence::states::read_states_with_gaps;
 use digiteyes_host::sequence::Sequence;
@@ -114,16 +113,12 @@ fn score_run(seed: u64, seq: &Path, size: (u32, u32)) -> Result<()> {
         }
         let mean = each.iter().sum::<f32>() / each.len() as f32;
         let worst = each.iter().copied().fold(f32::INFINITY, f32::min);
-        let palm_mm = TRANSLATION
-            .map(|i| (estimate[i] - true_state[i]).powi(2))
-            .sum::<f64>()
-            .sqrt();
+        let (palm_mm, truly) = judge_frame(estimate, true_state, &report, k, tip_limit);
         let tip = report
             .fingertip_mean_by_frame
             .get(k)
             .copied()
             .unwrap_or(f64::NAN);
-        let truly = !(tip <= tip_limit && palm_mm <= TRULY_LOST_PALM_MM);
         println!(
             "{seed},{},{k},{},{},{tip:.1},{palm_mm:.1},{mean:.4},{worst:.4}",
             u8::from(stereo),

@@ -5,26 +5,10 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader, Read, Write};
-use std::process::{Command, Stdio};
-use std::sync::mpsc;
-use std::time::{Duration, Instant};
+use std::process::Command;
 
-use digiteyes_core::protocol::{
-    encode, BoardMessage, Hypotheses, State, WireHypothesis, WireStatus, MAX_MESSAGE,
-};
+use digiteyes_core::protocol::{BoardMessage, Hypotheses, State, WireHypothesis, WireStatus};
 use digiteyes_host::sim::{self, SimOptions};
-use serialport::{SerialPort, TTYPort};
-
-/// Kills and reaps a child process when dropped, so a failing test leaves none behind.
-struct Reap(std::process::Child);
-
-impl Drop for Reap {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 /// `stream --hypotheses 3` on a whole-hand sequence: every tracked frame's state is followed
 /// by its hypotheses (one message each, 1 to 3 carried), which the summary counts; without
@@ -117,62 +101,15 @@ fn hypotheses(frame: u32, scores: &[f32]) -> BoardMessage {
 
 #[test]
 fn listen_prints_each_hypotheses_message_and_counts_them() {
-    let dir = tempfile::tempdir().unwrap();
-    let (mut board, slave) = TTYPort::pair().unwrap();
-    let path = slave.name().unwrap();
-    let mut listen = Reap(
-        Command::new(env!("CARGO_BIN_EXE_digiteyes"))
-            .args(["listen", "--port", &path, "--states", "3"])
-            .current_dir(dir.path())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap(),
-    );
-    let (tx, rx) = mpsc::channel();
-    let stderr = listen.0.stderr.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            let _ = tx.send(line);
-        }
-    });
-    let opened = rx.recv_timeout(Duration::from_secs(30)).unwrap();
-    assert!(opened.contains("listening on"), "{opened}");
-
     // Two frames with their hypotheses (3, then 1), then a third state: listen stops there.
-    let mut bytes = Vec::new();
-    for message in [
+    let messages = [
         state(7),
         hypotheses(7, &[0.9, 0.875, 0.5]),
         state(8),
         hypotheses(8, &[0.75]),
         state(9),
-    ] {
-        let mut buf = [0u8; MAX_MESSAGE];
-        bytes.extend_from_slice(encode(&message, &mut buf).unwrap());
-    }
-    board.write_all(&bytes).unwrap();
-
-    let deadline = Instant::now() + Duration::from_secs(30);
-    while listen.0.try_wait().unwrap().is_none() {
-        assert!(
-            Instant::now() < deadline,
-            "listen did not stop after 3 states"
-        );
-        // Polling for the child's exit, which it reaches by itself after three states.
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    assert!(listen.0.wait().unwrap().success());
-    let mut printed = String::new();
-    listen
-        .0
-        .stdout
-        .take()
-        .unwrap()
-        .read_to_string(&mut printed)
-        .unwrap();
-    reader.join().unwrap();
-    let summary: Vec<String> = rx.try_iter().collect();
+    ];
+    let (printed, summary) = common::listen_to(&messages, 3);
     let lines: Vec<&str> = printed.lines().collect();
     assert_eq!(lines.len(), 5, "{printed}");
     assert_eq!(

@@ -4,24 +4,10 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader, Read, Write};
-use std::process::{Command, Stdio};
-use std::sync::mpsc;
-use std::time::{Duration, Instant};
+use std::process::Command;
 
-use digiteyes_core::protocol::{encode, BoardMessage, State, WireStatus, MAX_MESSAGE};
+use digiteyes_core::protocol::{BoardMessage, State, WireStatus};
 use digiteyes_host::sim::{self, SimOptions};
-use serialport::{SerialPort, TTYPort};
-
-/// Kills and reaps a child process when dropped, so a failing test leaves none behind.
-struct Reap(std::process::Child);
-
-impl Drop for Reap {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 fn state(frame: u32, status: WireStatus) -> BoardMessage {
     let tracking = status == WireStatus::Tracking;
@@ -46,61 +32,16 @@ fn state(frame: u32, status: WireStatus) -> BoardMessage {
 
 #[test]
 fn listen_prints_each_states_status_and_counts_them() {
-    let dir = tempfile::tempdir().unwrap();
-    let (mut board, slave) = TTYPort::pair().unwrap();
-    let path = slave.name().unwrap();
-    let mut listen = Reap(
-        Command::new(env!("CARGO_BIN_EXE_digiteyes"))
-            .args(["listen", "--port", &path, "--states", "4"])
-            .current_dir(dir.path())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap(),
-    );
-    // Every stderr line, as it comes: the first says the port is open.
-    let (tx, rx) = mpsc::channel();
-    let stderr = listen.0.stderr.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            let _ = tx.send(line);
-        }
-    });
-    let opened = rx.recv_timeout(Duration::from_secs(30)).unwrap();
-    assert!(opened.contains("listening on"), "{opened}");
-
-    let mut bytes = Vec::new();
-    for (frame, status) in [
+    let messages: Vec<BoardMessage> = [
         (7, WireStatus::Searching),
         (8, WireStatus::Tracking),
         (9, WireStatus::Lost),
         (10, WireStatus::Searching),
-    ] {
-        let mut buf = [0u8; MAX_MESSAGE];
-        bytes.extend_from_slice(encode(&state(frame, status), &mut buf).unwrap());
-    }
-    board.write_all(&bytes).unwrap();
-
-    let deadline = Instant::now() + Duration::from_secs(30);
-    while listen.0.try_wait().unwrap().is_none() {
-        assert!(
-            Instant::now() < deadline,
-            "listen did not stop after 4 states"
-        );
-        // Polling for the child's exit, which it reaches by itself after four states.
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    assert!(listen.0.wait().unwrap().success());
-    let mut printed = String::new();
-    listen
-        .0
-        .stdout
-        .take()
-        .unwrap()
-        .read_to_string(&mut printed)
-        .unwrap();
-    reader.join().unwrap();
-    let summary: Vec<String> = rx.try_iter().collect();
+    ]
+    .into_iter()
+    .map(|(frame, status)| state(frame, status))
+    .collect();
+    let (printed, summary) = common::listen_to(&messages, 4);
     let lines: Vec<&str> = printed.lines().collect();
     assert_eq!(lines.len(), 4, "{printed}");
     assert!(

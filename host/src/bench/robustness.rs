@@ -13,7 +13,7 @@ use digiteyes_core::motion::MotionConfig;
 use digiteyes_core::state::TRANSLATION;
 use serde::Serialize;
 
-use crate::eval::{evaluate, stats};
+use crate::eval::{evaluate, stats, EvalReport};
 use crate::scenarios::{render_scenario, RenderOptions};
 use crate::sequence::states::read_states_with_gaps;
 use crate::sequence::Sequence;
@@ -124,6 +124,29 @@ pub struct SeedResult {
     pub iterations_per_frame: f64,
 }
 
+/// Frame `k`'s palm position error (mm) and whether it is truly lost: its mean fingertip
+/// error (from `report`) over `tip_limit_px`, or its palm over [`TRULY_LOST_PALM_MM`] from
+/// the truth (a missing or non-finite error counts as lost).
+pub fn judge_frame(
+    estimate: &[f64],
+    truth: &[f64],
+    report: &EvalReport,
+    k: usize,
+    tip_limit_px: f64,
+) -> (f64, bool) {
+    let palm_mm = TRANSLATION
+        .map(|i| (estimate[i] - truth[i]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let tip = report
+        .fingertip_mean_by_frame
+        .get(k)
+        .copied()
+        .unwrap_or(f64::NAN);
+    let within = tip <= tip_limit_px && palm_mm <= TRULY_LOST_PALM_MM;
+    (palm_mm, !within)
+}
+
 /// Renders, tracks and judges seed `seed` in `dir`.
 pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResult> {
     let stereo = seed.is_multiple_of(2);
@@ -176,17 +199,7 @@ pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResu
         iterations_per_frame: stats::mean(&iterations),
     };
     for (k, (estimate, true_state)) in table.table.rows.iter().zip(&truth.rows).enumerate() {
-        let palm_mm = TRANSLATION
-            .map(|i| (estimate[i] - true_state[i]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        let tip = report
-            .fingertip_mean_by_frame
-            .get(k)
-            .copied()
-            .unwrap_or(f64::NAN);
-        let within = tip <= tip_limit && palm_mm <= TRULY_LOST_PALM_MM;
-        let truly = !within;
+        let (palm_mm, truly) = judge_frame(estimate, true_state, &report, k, tip_limit);
         let flagged = lost.get(k).is_some_and(|&v| v != 0.0);
         match (flagged, truly) {
             (true, true) => result.lost_flagged_and_true += 1,
