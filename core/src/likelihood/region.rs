@@ -29,9 +29,8 @@ pub const EXTENT_PERCENTILE: u32 = 2;
 /// The fewest bright samples for a region.
 pub const MIN_REGION_SAMPLES: u32 = 16;
 
-/// The frame's bright region.
+/// The frame's bright region (not `defmt::Format`: nalgebra's vectors are not).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Region {
     /// Otsu's threshold (grey level): brighter samples are the region.
     pub threshold: u8,
