@@ -219,6 +219,12 @@ impl AutoTracker {
         self.finder.set_accept(accept);
     }
 
+    /// Sets how the search's leaves are refined and judged (its acceptance thresholds
+    /// included).
+    pub fn set_finder(&mut self, config: FinderConfig) {
+        self.finder.set_config(config);
+    }
+
     /// The acceptance thresholds.
     pub fn accept(&self) -> AcceptConfig {
         self.finder.config().accept

@@ -101,6 +101,11 @@ impl Finder {
         &mut self.acquirer
     }
 
+    /// New parameters for the leaves refined from now on.
+    pub fn set_config(&mut self, config: FinderConfig) {
+        self.config = config;
+    }
+
     /// New acceptance thresholds for the leaves judged from now on.
     pub fn set_accept(&mut self, accept: AcceptConfig) {
         self.config.accept = accept;
