@@ -33,7 +33,7 @@ use crate::acquire::{
     AcceptConfig, AcquireConfig, Acquirer, Finder, FinderConfig, FinderStep, WorkingVolume,
 };
 use crate::camera::Camera;
-use crate::config::{MAX_CAMERAS, MAX_STATES};
+use crate::config::{MAX_CAMERAS, MAX_HYPOTHESES, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
 use crate::hypotheses::{HypothesesConfig, Hypothesis, MultiTracker};
@@ -155,6 +155,12 @@ pub struct AutoTracker {
     /// [`LOCAL_FOLLOW_SCORE`]: refined again on the next.
     following: Option<[f32; MAX_STATES]>,
     recovery: Recovery,
+    /// The hypotheses' parameters as configured ([`AutoTracker::set_hypotheses`]); while
+    /// confirming an acquisition the tracker carries more.
+    hypotheses: HypothesesConfig,
+    /// Tracking frames left in which the search's other leaves are carried as hypotheses
+    /// beside the accepted one ([`FinderConfig::confirm_frames`]).
+    confirm_left: u32,
 }
 
 impl AutoTracker {
@@ -185,6 +191,8 @@ impl AutoTracker {
             local_left: 0,
             following: None,
             recovery: Recovery::Search,
+            hypotheses: HypothesesConfig::default(),
+            confirm_left: 0,
         })
     }
 
@@ -238,7 +246,10 @@ impl AutoTracker {
     /// Sets how many hypotheses are tracked (one: the single tracker, bit for bit). Their
     /// likelihood uses the search's edge-map buffers, so its stride must be the search's.
     pub fn set_hypotheses(&mut self, config: HypothesesConfig) {
-        self.multi.set_config(config);
+        self.hypotheses = config;
+        if self.confirm_left == 0 {
+            self.multi.set_config(config);
+        }
     }
 
     /// The hypotheses carried while tracking, best first (the last frame's).
@@ -296,6 +307,13 @@ impl AutoTracker {
         edge_buffers: &mut [&mut [u8]],
     ) -> Result<AutoReport, AutoError> {
         let multi = self.multi.track(frames, edge_buffers)?;
+        if self.confirm_left > 0 {
+            self.confirm_left -= 1;
+            if self.confirm_left == 0 {
+                // The best of the leaves carried goes on alone (or with the configured count).
+                self.multi.set_config(self.hypotheses);
+            }
+        }
         let report = multi.report;
         if report.lost {
             self.lost_run = self.lost_run.saturating_add(1);
@@ -304,6 +322,8 @@ impl AutoTracker {
             {
                 self.finder.restart();
                 self.following = None;
+                self.confirm_left = 0;
+                self.multi.set_config(self.hypotheses);
                 self.local_left = if self.ever_tracked {
                     LOCAL_SEARCH_FRAMES
                 } else {
@@ -339,11 +359,35 @@ impl AutoTracker {
 
     /// The tracker holds the hand (refined on this frame): the status becomes `Tracking`.
     fn found(&mut self) {
+        self.confirm_left = 0;
+        self.multi.set_config(self.hypotheses);
         self.multi.adopt();
         self.status = Status::Tracking;
         self.lost_run = 0;
         self.local_left = 0;
         self.hold_tracked();
+    }
+
+    /// After a leaf is accepted: when [`FinderConfig::confirm_frames`] asks, the search's
+    /// other good leaves join it as hypotheses for that many frames, so the likelihood over
+    /// several frames (and each leaf's Gauss–Newton on each) chooses among them.
+    fn confirm(&mut self) -> Result<(), AutoError> {
+        let finder = *self.finder.config();
+        let others = self.finder.found_leaves().get(1..).unwrap_or(&[]);
+        if finder.confirm_frames == 0 || others.is_empty() {
+            return Ok(());
+        }
+        let count = finder
+            .confirm_hypotheses
+            .max(self.hypotheses.count)
+            .min(MAX_HYPOTHESES as u8);
+        self.multi.set_config(HypothesesConfig {
+            count,
+            ..self.hypotheses
+        });
+        self.multi.seed(others)?;
+        self.confirm_left = u32::from(finder.confirm_frames);
+        Ok(())
     }
 
     /// One frame of local re-acquisition: the last good state slid over each camera's edge
@@ -497,6 +541,7 @@ impl AutoTracker {
             }
             FinderStep::Found { verdict, report } => {
                 self.found();
+                self.confirm()?;
                 out.leaf_score = Some(verdict.score);
                 out.status = Status::Tracking;
                 out.report = FrameReport {

@@ -70,6 +70,8 @@ struct Args {
     #[arg(long)]
     tree_levels: Option<u8>,
     #[arg(long)]
+    tree_pose_levels: Option<u8>,
+    #[arg(long)]
     rounds: Option<u8>,
     #[arg(long)]
     refine_seeds: Option<u8>,
@@ -84,6 +86,18 @@ struct Args {
     passes: Option<u8>,
     #[arg(long)]
     min_score: Option<f32>,
+    /// Re-place leaves on the frame they are refined on (true/false).
+    #[arg(long)]
+    replace: Option<bool>,
+    /// Frames the accepted leaf is carried with the other leaves as hypotheses.
+    #[arg(long)]
+    confirm_frames: Option<u8>,
+    /// Hypotheses carried while confirming.
+    #[arg(long)]
+    confirm_k: Option<u8>,
+    /// Score a leaf refined with the accepted one needs to join it.
+    #[arg(long)]
+    alternative_score: Option<f32>,
     #[arg(long)]
     min_camera_score: Option<f32>,
     /// Write every refined leaf's judgement and true error here (CSV).
@@ -125,6 +139,7 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         spins: args.spins.unwrap_or(d.spins),
         coarse_poses: args.coarse_poses.unwrap_or(d.coarse_poses),
         tree_levels: args.tree_levels.unwrap_or(d.tree_levels),
+        tree_pose_levels: args.tree_pose_levels.unwrap_or(d.tree_pose_levels),
         refine_rounds: args.rounds.unwrap_or(d.refine_rounds),
         refine_seeds: args.refine_seeds.unwrap_or(d.refine_seeds),
         coarse_sampling: match args.coarse_sampling.as_deref() {
@@ -142,6 +157,10 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             min_score: args.min_score.unwrap_or(f.accept.min_score),
             min_camera_score: args.min_camera_score.unwrap_or(f.accept.min_camera_score),
         },
+        replace_leaves: args.replace.unwrap_or(f.replace_leaves),
+        confirm_frames: args.confirm_frames.unwrap_or(f.confirm_frames),
+        confirm_hypotheses: args.confirm_k.unwrap_or(f.confirm_hypotheses),
+        alternative_score: args.alternative_score.unwrap_or(f.alternative_score),
     };
     (acquire, finder)
 }
