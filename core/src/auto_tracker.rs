@@ -31,6 +31,7 @@ use heapless::Vec;
 
 use crate::acquire::{
     AcceptConfig, AcquireConfig, Acquirer, Finder, FinderConfig, FinderStep, WorkingVolume,
+    LOCAL_VARIANTS, MAX_KEEP,
 };
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_HYPOTHESES, MAX_STATES};
@@ -61,6 +62,13 @@ pub const LOCAL_REFINE_PASSES: u32 = 2;
 /// followed to the next frame, where it is refined again: a hand half back in view, or moved
 /// far from the last good state, is then closed in on over a few frames.
 pub const LOCAL_FOLLOW_SCORE: f32 = 0.8;
+
+/// How far the local re-acquisition turns the last good state's palm in its variants (rad).
+pub const LOCAL_TURN_RAD: f32 = 0.3;
+
+/// How far the local re-acquisition moves the last good state's palm in depth in its
+/// variants, as a share of its distance from the first camera.
+pub const LOCAL_DEPTH_SHARE: f32 = 0.15;
 
 /// What the tracker does once the hand has been lost for [`LOST_FRAMES_BEFORE_SEARCH`] frames.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -131,6 +139,7 @@ pub struct AutoReport {
 
 /// A hypothesis refined on this frame: its state, its mean and worst camera's likelihood
 /// score, and the tracker's report of its last pass.
+#[derive(Clone, Copy)]
 struct Refined {
     score: f32,
     worst_camera: f32,
@@ -368,12 +377,12 @@ impl AutoTracker {
         self.hold_tracked();
     }
 
-    /// After a leaf is accepted: when [`FinderConfig::confirm_frames`] asks, the search's
-    /// other good leaves join it as hypotheses for that many frames, so the likelihood over
-    /// several frames (and each leaf's Gauss–Newton on each) chooses among them.
-    fn confirm(&mut self) -> Result<(), AutoError> {
+    /// After a leaf is accepted: when [`FinderConfig::confirm_frames`] asks, the other good
+    /// leaves (`others`: the search's, or the local re-acquisition's other starts) join it as
+    /// hypotheses for that many frames, so the likelihood over several frames (and each
+    /// leaf's Gauss–Newton on each) chooses among them.
+    fn confirm(&mut self, others: &[[f32; MAX_STATES]]) -> Result<(), AutoError> {
         let finder = *self.finder.config();
-        let others = self.finder.found_leaves().get(1..).unwrap_or(&[]);
         if finder.confirm_frames == 0 || others.is_empty() {
             return Ok(());
         }
@@ -390,60 +399,88 @@ impl AutoTracker {
         Ok(())
     }
 
-    /// One frame of local re-acquisition: the last good state slid over each camera's edge
-    /// map near where it projects, and the hypothesis followed from the last frame (if any),
-    /// each refined by Gauss–Newton and scored over every camera; the best is accepted if the
-    /// acceptance test takes it, else followed to the next frame if it reaches
-    /// [`LOCAL_FOLLOW_SCORE`].
+    /// One frame of local re-acquisition: a variant of the last good state (itself on every
+    /// other frame, else turned or moved in depth: [`Acquirer::variant`]) slid over the first
+    /// camera's edge map near where it projects and placed on the frame's bright regions,
+    /// and the hypothesis followed from the last frame (if any), each refined by Gauss–Newton
+    /// and scored over every camera; the best is accepted if the acceptance test takes it,
+    /// else followed to the next frame if it reaches [`LOCAL_FOLLOW_SCORE`].
     fn local_search(
         &mut self,
         frames: &[FrameView<'_>],
         maps: &[EdgeMap<'_>],
         out: &mut AutoReport,
     ) -> Result<(), AutoError> {
+        let frame = LOCAL_SEARCH_FRAMES.saturating_sub(self.local_left);
         self.local_left = self.local_left.saturating_sub(1);
         out.local = true;
         let n = self.multi.tracker().model().n_states().min(MAX_STATES);
-        let seed = self.held;
-        let mut best: Option<Refined> = None;
-        let followed = self.following.take();
-        for c in 0..=maps.len() {
+        let k = if frame.is_multiple_of(2) {
+            0
+        } else {
+            1 + (frame / 2) % (LOCAL_VARIANTS - 1)
+        };
+        let seed = {
             let tracker = self.multi.tracker();
-            let start = match (maps.get(c), tracker.cameras().get(c).copied()) {
-                (Some(map), Some(camera)) => {
-                    let near_px = camera.width as f32 * LOCAL_WINDOW;
-                    self.finder
-                        .acquirer_mut()
-                        .place(tracker.model(), &camera, map, seed, Some(near_px))
-                        .map(|placed| placed.q)
+            self.finder.acquirer().variant(
+                tracker.cameras(),
+                &self.held,
+                k,
+                LOCAL_TURN_RAD,
+                LOCAL_DEPTH_SHARE,
+            )
+        };
+        let followed = self.following.take();
+        let mut refined: Vec<Refined, 3> = Vec::new();
+        for start in 0..3 {
+            let tracker = self.multi.tracker();
+            let q = match start {
+                0 => match (maps.first(), tracker.cameras().first().copied()) {
+                    (Some(map), Some(camera)) => {
+                        let near_px = camera.width as f32 * LOCAL_WINDOW;
+                        self.finder
+                            .acquirer_mut()
+                            .place(tracker.model(), &camera, map, seed, Some(near_px))
+                            .map(|placed| placed.q)
+                    }
+                    _ => None,
+                },
+                1 => {
+                    let mut q = seed;
+                    let cameras = tracker.cameras();
+                    let placed = self.finder.acquirer_mut().replace(
+                        tracker.model(),
+                        &cameras[..cameras.len().min(MAX_CAMERAS)],
+                        maps,
+                        &mut q,
+                    );
+                    placed.then_some(q)
                 }
                 _ => followed,
             };
-            let Some(start) = start else { continue };
-            let refined = self.refine(frames, maps, start, n)?;
+            let Some(q) = q else { continue };
+            let r = self.refine(frames, maps, q, n)?;
             out.evaluated = out.evaluated.saturating_add(1);
-            if best.as_ref().is_none_or(|b| refined.score > b.score) {
-                best = Some(refined);
-            }
+            let _ = refined.push(r);
         }
-        let Some(Refined {
-            score,
-            worst_camera,
-            q,
-            report,
-        }) = best
-        else {
+        refined.sort_unstable_by(|a, b| b.score.total_cmp(&a.score));
+        let Some(best) = refined.first() else {
             return Ok(());
         };
+        let (score, q, report) = (best.score, best.q, best.report);
         out.leaf_score = Some(score);
-        let verdict = self
-            .finder
-            .config()
-            .accept
-            .judge(score, worst_camera, report.lost);
+        let finder = *self.finder.config();
+        let verdict = finder.accept.judge(score, best.worst_camera, report.lost);
         if verdict.accepted {
+            let mut others: Vec<[f32; MAX_STATES], 3> = Vec::new();
+            for r in refined.iter().skip(1) {
+                if !r.report.lost && r.score >= finder.alternative_score {
+                    let _ = others.push(r.q);
+                }
+            }
             self.multi.tracker_mut().restart_fresh(&q[..n])?;
             self.found();
+            self.confirm(&others)?;
             out.status = Status::Tracking;
             out.report = FrameReport {
                 lost: false,
@@ -541,7 +578,11 @@ impl AutoTracker {
             }
             FinderStep::Found { verdict, report } => {
                 self.found();
-                self.confirm()?;
+                let mut others: Vec<[f32; MAX_STATES], MAX_KEEP> = Vec::new();
+                for q in self.finder.found_leaves().iter().skip(1) {
+                    let _ = others.push(*q);
+                }
+                self.confirm(&others)?;
                 out.leaf_score = Some(verdict.score);
                 out.status = Status::Tracking;
                 out.report = FrameReport {

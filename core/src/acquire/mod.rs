@@ -27,7 +27,7 @@ use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
-use crate::likelihood::{evaluate, EdgeMap, Likelihood, LikelihoodConfig, Region, Samples};
+use crate::likelihood::{mean_score, EdgeMap, Likelihood, LikelihoodConfig, Region, Samples};
 use crate::model::Model;
 use crate::nalgebra::{Vector2, Vector3};
 
@@ -55,6 +55,9 @@ pub const LOOKUPS_PER_EVALUATION: u32 = 600;
 /// full one: its cheaper score (3 points per silhouette line instead of 6, a 10×10 silhouette
 /// grid instead of 16×16) costs about half (docs/performance.md). Charged as 1 in 2.
 pub const COARSE_EVALUATION_SHARE: f32 = 0.5;
+
+/// Variants of a state [`Acquirer::variant`] gives: itself, six turns, two depths.
+pub const LOCAL_VARIANTS: u32 = 9;
 
 /// The best hypotheses kept between levels.
 pub const MAX_KEEP: usize = 8;
@@ -323,8 +326,15 @@ impl Acquirer {
                 _ => self.config.likelihood,
             };
             let mut each = [Likelihood::default(); MAX_CAMERAS];
-            let n =
-                self.likelihoods_with(&likelihood, model, cameras, frames, edges, &q, &mut each);
+            let n = self.scratch.likelihoods(
+                model,
+                cameras,
+                frames,
+                edges,
+                &q[..self.n_states],
+                &likelihood,
+                &mut each,
+            );
             let score = mean_score(&each[..n]);
             keep(&mut self.next, Candidate { score, q });
             let scored = n_cameras.max(1) as u32;
@@ -347,6 +357,41 @@ impl Acquirer {
             }
             _ => Progress::Searching { evaluated },
         }
+    }
+
+    /// Variant `k` of `q` for the local re-acquisition: 0 is `q` itself; 1..=6 its palm
+    /// turned by `turn_rad` either way about each of its axes; 7 and 8 its palm moved
+    /// `depth_share` nearer and farther along the first camera's ray. Variants that do not
+    /// apply (the states fixed) give `q`. `k` is taken modulo [`LOCAL_VARIANTS`].
+    pub fn variant(
+        &self,
+        cameras: &[Camera],
+        q: &[f32; MAX_STATES],
+        k: u32,
+        turn_rad: f32,
+        depth_share: f32,
+    ) -> [f32; MAX_STATES] {
+        let m = k % LOCAL_VARIANTS;
+        let mut out = *q;
+        let sign = if m.is_multiple_of(2) { -1.0 } else { 1.0 };
+        match m {
+            1..=6 if self.frees(QUATERNION) => {
+                let mut axis = [0.0f32; 3];
+                axis[((m - 1) / 2) as usize] = sign;
+                let turned = compose(&[q[0], q[1], q[2], q[3]], &axis_angle(axis, turn_rad));
+                out[..4].copy_from_slice(&turned);
+            }
+            7 | 8 if self.frees(TRANSLATION) => {
+                if let Some(camera) = cameras.first() {
+                    let eye = camera.centre();
+                    let p = Vector3::new(q[4], q[5], q[6]);
+                    let moved = eye + (p - eye) * (1.0 + sign * depth_share);
+                    out[4..7].copy_from_slice(&[moved.x, moved.y, moved.z]);
+                }
+            }
+            _ => {}
+        }
+        out
     }
 
     /// Moves the palm of `q` onto this frame's bright regions (`edges`' regions), its depth
@@ -407,18 +452,9 @@ impl Acquirer {
         edges: &[EdgeMap<'_>],
         q: &[f32; MAX_STATES],
     ) -> (f32, f32) {
-        let mut each = [Likelihood::default(); MAX_CAMERAS];
-        let n = self.likelihoods(model, cameras, frames, edges, q, &mut each);
-        let worst = each
-            .iter()
-            .take(n)
-            .map(|l| l.score)
-            .fold(f32::INFINITY, f32::min);
-        if n == 0 {
-            (0.0, 0.0)
-        } else {
-            (mean_score(&each[..n]), worst)
-        }
+        let config = self.config.likelihood;
+        self.scratch
+            .score_cameras(model, cameras, frames, edges, &q[..self.n_states], &config)
     }
 
     /// The likelihood of `q` in each camera into `out`; returns how many were scored (0 when
@@ -433,35 +469,8 @@ impl Acquirer {
         out: &mut [Likelihood; MAX_CAMERAS],
     ) -> usize {
         let config = self.config.likelihood;
-        self.likelihoods_with(&config, model, cameras, frames, edges, q, out)
-    }
-
-    /// [`Acquirer::likelihoods`] under `config`.
-    #[allow(clippy::too_many_arguments)]
-    fn likelihoods_with(
-        &mut self,
-        config: &LikelihoodConfig,
-        model: &Model,
-        cameras: &[Camera],
-        frames: &[FrameView<'_>],
-        edges: &[EdgeMap<'_>],
-        q: &[f32; MAX_STATES],
-        out: &mut [Likelihood; MAX_CAMERAS],
-    ) -> usize {
-        if !self.scratch.pose(model, &q[..self.n_states]) {
-            return 0;
-        }
-        let mut n = 0;
-        for (((camera, frame), edges), slot) in
-            cameras.iter().zip(frames).zip(edges).zip(out.iter_mut())
-        {
-            if !self.scratch.project(model, camera) {
-                return 0;
-            }
-            *slot = evaluate(&self.scratch.view, camera, frame, edges, config);
-            n += 1;
-        }
-        n
+        self.scratch
+            .likelihoods(model, cameras, frames, edges, &q[..self.n_states], &config, out)
     }
 
     /// Without a region: the palm on the ray through the volume's centre, at depth `k` of
@@ -757,15 +766,6 @@ impl Acquirer {
 
     fn frees(&self, range: core::ops::Range<usize>) -> bool {
         range.into_iter().all(|s| self.free.contains(s))
-    }
-}
-
-/// The mean score of `each` (0 for none).
-fn mean_score(each: &[Likelihood]) -> f32 {
-    if each.is_empty() {
-        0.0
-    } else {
-        each.iter().map(|l| l.score).sum::<f32>() / each.len() as f32
     }
 }
 
