@@ -170,6 +170,8 @@ pub struct AutoTracker {
     /// Tracking frames left in which the search's other leaves are carried as hypotheses
     /// beside the accepted one ([`FinderConfig::confirm_frames`]).
     confirm_left: u32,
+    /// The best hypothesis' scores summed over the confirming frames so far, and how many.
+    confirm_scores: (f32, u32),
 }
 
 impl AutoTracker {
@@ -202,6 +204,7 @@ impl AutoTracker {
             recovery: Recovery::Search,
             hypotheses: HypothesesConfig::default(),
             confirm_left: 0,
+            confirm_scores: (0.0, 0),
         })
     }
 
@@ -316,14 +319,40 @@ impl AutoTracker {
         edge_buffers: &mut [&mut [u8]],
     ) -> Result<AutoReport, AutoError> {
         let multi = self.multi.track(frames, edge_buffers)?;
+        let mut refuted = false;
         if self.confirm_left > 0 {
             self.confirm_left -= 1;
+            self.confirm_scores.0 += multi.score;
+            self.confirm_scores.1 += 1;
             if self.confirm_left == 0 {
-                // The best of the leaves carried goes on alone (or with the configured count).
+                // The best of the leaves carried goes on alone (or with the configured count),
+                // unless it scored too little over the frames it was confirmed on.
                 self.multi.set_config(self.hypotheses);
+                let (sum, n) = self.confirm_scores;
+                refuted = sum / (n.max(1) as f32) < self.finder.config().confirm_min_score;
             }
         }
         let report = multi.report;
+        if refuted && self.recovery == Recovery::Search {
+            // Not the hand after all: search again from scratch.
+            self.finder.restart();
+            self.following = None;
+            self.local_left = 0;
+            self.lost_run = 0;
+            self.status = Status::Searching;
+            return Ok(AutoReport {
+                status: self.status,
+                report: FrameReport {
+                    lost: true,
+                    ..report
+                },
+                evaluated: 0,
+                leaf_score: None,
+                local: false,
+                hypotheses: multi.count,
+                best_score: multi.score,
+            });
+        }
         if report.lost {
             self.lost_run = self.lost_run.saturating_add(1);
             self.status = if self.lost_run >= LOST_FRAMES_BEFORE_SEARCH
@@ -390,12 +419,17 @@ impl AutoTracker {
             .confirm_hypotheses
             .max(self.hypotheses.count)
             .min(MAX_HYPOTHESES as u8);
+        // The leaves themselves are compared: nothing sampled around them (a confirming frame
+        // costs one tracker pass and one score per leaf).
         self.multi.set_config(HypothesesConfig {
             count,
+            spawn_per_frame: 0,
+            keep_fingers: false,
             ..self.hypotheses
         });
         self.multi.seed(others)?;
         self.confirm_left = u32::from(finder.confirm_frames);
+        self.confirm_scores = (0.0, 0);
         Ok(())
     }
 

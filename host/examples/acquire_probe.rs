@@ -95,6 +95,9 @@ struct Args {
     /// Hypotheses carried while confirming.
     #[arg(long)]
     confirm_k: Option<u8>,
+    /// Mean score over the confirming frames needed to keep the hand.
+    #[arg(long)]
+    confirm_min_score: Option<f32>,
     /// Score a leaf refined with the accepted one needs to join it.
     #[arg(long)]
     alternative_score: Option<f32>,
@@ -114,6 +117,13 @@ struct Args {
     /// Print each run's frame-by-frame statuses.
     #[arg(long)]
     verbose: bool,
+    /// The fingertip error (px at 640 wide, scaled to `--width`) a frame must be within to
+    /// count as right.
+    #[arg(long, default_value_t = 10.0)]
+    limit_px: f32,
+    /// Print the best hypothesis' score and tip error on frames with several hypotheses.
+    #[arg(long)]
+    trace: bool,
     /// The blackout sweep instead: render frames A..B without the hand, track from the
     /// initial state, and report whether each seed is re-acquired within `--within` frames
     /// of the hand's return (use with `--frames 200`).
@@ -161,6 +171,7 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         confirm_frames: args.confirm_frames.unwrap_or(f.confirm_frames),
         confirm_hypotheses: args.confirm_k.unwrap_or(f.confirm_hypotheses),
         alternative_score: args.alternative_score.unwrap_or(f.alternative_score),
+        confirm_min_score: args.confirm_min_score.unwrap_or(f.confirm_min_score),
     };
     (acquire, finder)
 }
@@ -332,7 +343,7 @@ fn run(
     let truth = sequence.read_truth()?;
     let (acquire, _) = configs(args);
     let mut auto = auto_tracker(sequence, args, None)?;
-    let limit = 10.0 * args.width as f32 / 640.0;
+    let limit = args.limit_px * args.width as f32 / 640.0;
     let mut bufs = buffers(&sequence.cameras, &acquire);
     let mut good = Vec::new();
     let mut out = Run {
@@ -366,6 +377,12 @@ fn run(
             }
         }
         line.push(status_char(&report, was));
+        if args.trace && report.hypotheses > 1 {
+            eprintln!(
+                "trace {label} {k} {} {:.4} {e:.2}",
+                report.hypotheses, report.best_score
+            );
+        }
         if claimed && out.first_claim.is_none() {
             out.first_claim = Some((k, e));
         }
@@ -407,7 +424,7 @@ fn blackout_run(
     let (acquire, _) = configs(args);
     let initial: Vec<f32> = sequence.initial_state.iter().map(|&v| v as f32).collect();
     let mut auto = auto_tracker(sequence, args, Some(&initial))?;
-    let limit = 10.0 * args.width as f32 / 640.0;
+    let limit = args.limit_px * args.width as f32 / 640.0;
     let mut bufs = buffers(&sequence.cameras, &acquire);
     let (mut good, mut over) = (Vec::new(), Vec::new());
     let mut out = BlackoutRun {
@@ -666,7 +683,7 @@ fn main() -> Result<()> {
             let sequence = Sequence::open(&seq)?;
             let r = run(&sequence, &args, &format!("{rig}-{seed}"), &mut csv)?;
             if args.oracle {
-                let held = oracle_holds(&sequence, 10, 10.0 * args.width as f32 / 640.0)?;
+                let held = oracle_holds(&sequence, 10, args.limit_px * args.width as f32 / 640.0)?;
                 eprintln!("{rig}-{seed}: from the truth at frame 10, held: {held}");
             }
             println!(

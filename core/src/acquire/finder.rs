@@ -41,6 +41,9 @@ pub struct FinderConfig {
     /// A leaf refined alongside the accepted one joins it as a hypothesis when it scores at
     /// least this (and Gauss–Newton did not lose it).
     pub alternative_score: f32,
+    /// The mean score over the confirming frames the best hypothesis needs for the hand to
+    /// be kept; under it the hand is given up and searched for again (0: always kept).
+    pub confirm_min_score: f32,
 }
 
 impl Default for FinderConfig {
@@ -51,9 +54,10 @@ impl Default for FinderConfig {
             passes_per_leaf: 2,
             accept: AcceptConfig::default(),
             replace_leaves: true,
-            confirm_frames: 0,
+            confirm_frames: 5,
             confirm_hypotheses: 4,
             alternative_score: 0.85,
+            confirm_min_score: 0.0,
         }
     }
 }
