@@ -179,7 +179,8 @@ impl Finder {
                         // At most MAX_KEEP: cannot overflow.
                         let _ = self.leaves.push(c.q);
                     }
-                    0
+                    // What the search's last step spent on this frame.
+                    self.acquirer.last_step_cost
                 }
             };
             // The leaves are refined from the next frame on: this one's budget is spent.

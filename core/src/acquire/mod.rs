@@ -190,6 +190,9 @@ pub struct Acquirer {
     /// The most one hypothesis or slide has cost (evaluations): how far a step can overrun
     /// its budget, since the last item is finished once begun.
     pub largest_item_cost: u16,
+    /// What the last [`Acquirer::step`] spent against its budget (also when it ended the
+    /// search).
+    pub last_step_cost: u16,
 }
 
 impl Acquirer {
@@ -223,6 +226,7 @@ impl Acquirer {
             lookups: 0,
             coarse_uncharged: 0,
             largest_item_cost: 0,
+            last_step_cost: 0,
         }
     }
 
@@ -348,6 +352,7 @@ impl Acquirer {
             };
             evaluated = evaluated.saturating_add(self.finish_item(charged));
         }
+        self.last_step_cost = evaluated;
         match (self.stage, self.best.first()) {
             (Stage::Done, Some(best)) => Progress::Found(*best),
             (Stage::Done, None) => {
