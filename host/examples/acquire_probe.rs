@@ -484,8 +484,7 @@ fn blackout_sweep(args: &Args, dark: &std::ops::Range<usize>) -> Result<()> {
             println!(
                 "| {seed} | {rig} | {} | {} | {} | {} |",
                 r.tracked_to_dark,
-                r.reacquired_after
-                    .map_or("never".into(), |k| k.to_string()),
+                r.reacquired_after.map_or("never".into(), |k| k.to_string()),
                 r.dark_claimed,
                 r.searching
             );

@@ -58,7 +58,10 @@ fn whole(q: &[f32]) -> [f32; MAX_STATES] {
 }
 
 fn palm_error_mm(a: &[f32], b: &[f32]) -> f32 {
-    (0..3).map(|i| (a[4 + i] - b[4 + i]).powi(2)).sum::<f32>().sqrt()
+    (0..3)
+        .map(|i| (a[4 + i] - b[4 + i]).powi(2))
+        .sum::<f32>()
+        .sqrt()
 }
 
 #[test]
@@ -100,14 +103,29 @@ fn seeded_hypotheses_start_fresh_are_capped_at_the_count_and_the_right_one_is_ke
     multi.seed(&others).unwrap();
     let h = multi.hypotheses();
     assert_eq!(h.len(), 3, "capped at the count: the first and two others");
-    assert_eq!(h[0].memory, first, "the tracker's own memory comes first, kept");
-    assert_eq!(multi.tracker().memory(), first, "the tracker still holds the first");
+    assert_eq!(
+        h[0].memory, first,
+        "the tracker's own memory comes first, kept"
+    );
+    assert_eq!(
+        multi.tracker().memory(),
+        first,
+        "the tracker still holds the first"
+    );
     for (h, q) in h[1..].iter().zip(&others) {
         // The state as given (its quaternion renormalised).
-        let near = h.memory.state.iter().zip(&q[..n]).all(|(a, b)| (a - b).abs() < 1e-5);
+        let near = h
+            .memory
+            .state
+            .iter()
+            .zip(&q[..n])
+            .all(|(a, b)| (a - b).abs() < 1e-5);
         assert!(near, "{:?} vs {:?}", &h.memory.state[..], &q[..n]);
         assert_eq!(h.memory.velocity, None, "fresh: no motion");
-        assert_eq!(h.memory.silhouette_reference, None, "fresh: no silhouette reference");
+        assert_eq!(
+            h.memory.silhouette_reference, None,
+            "fresh: no silhouette reference"
+        );
     }
     for k in 1..seq.frames {
         step(&mut multi, k);
@@ -198,7 +216,10 @@ fn the_local_variants_turn_and_move_the_last_good_state() {
             }
             _ => {
                 assert!(angle < 1e-6);
-                assert!((depth - 1.0).abs() > 0.14 && (depth - 1.0).abs() < 0.16, "{depth}");
+                assert!(
+                    (depth - 1.0).abs() > 0.14 && (depth - 1.0).abs() < 0.16,
+                    "{depth}"
+                );
             }
         }
     }
@@ -257,8 +278,14 @@ fn an_accepted_leaf_is_confirmed_among_the_others_and_a_refuted_one_given_up() {
         after[..4].iter().any(|&(_, n)| n > 1),
         "several leaves carried while confirming: {after:?}"
     );
-    assert!(after.iter().all(|&(s, _)| s == Status::Tracking), "{after:?}");
-    assert_eq!(after[4].1, 1, "back to one hypothesis after 5 frames: {after:?}");
+    assert!(
+        after.iter().all(|&(s, _)| s == Status::Tracking),
+        "{after:?}"
+    );
+    assert_eq!(
+        after[4].1, 1,
+        "back to one hypothesis after 5 frames: {after:?}"
+    );
     // A bar no hand reaches: the acquisition is refuted after the confirming frames.
     let refuting = FinderConfig {
         confirm_min_score: 1.5,
@@ -266,7 +293,10 @@ fn an_accepted_leaf_is_confirmed_among_the_others_and_a_refuted_one_given_up() {
     };
     let (k2, after) = acquire(&sequence, refuting, 6);
     assert_eq!(k2, k);
-    assert!(after[..4].iter().all(|&(s, _)| s == Status::Tracking), "{after:?}");
+    assert!(
+        after[..4].iter().all(|&(s, _)| s == Status::Tracking),
+        "{after:?}"
+    );
     assert_eq!(after[4].0, Status::Searching, "refuted: {after:?}");
     assert_eq!(after[5].0, Status::Searching, "searching again: {after:?}");
 }

@@ -191,8 +191,7 @@ impl Finder {
             });
         }
         let n = tracker.model().n_states().min(MAX_STATES);
-        let mut refined_now: Vec<(Verdict, [f32; MAX_STATES], FrameReport), MAX_KEEP> =
-            Vec::new();
+        let mut refined_now: Vec<(Verdict, [f32; MAX_STATES], FrameReport), MAX_KEEP> = Vec::new();
         while refined_now.len() < usize::from(self.config.leaves_per_frame.max(1)) {
             let Some(mut leaf) = self.leaves.pop() else {
                 break;
@@ -287,6 +286,10 @@ impl Finder {
             self.acquirer
                 .score_cameras(tracker.model(), &cameras[..n_cameras], frames, edges, &q)
         };
-        Ok((self.config.accept.judge(score, worst, report.lost), q, report))
+        Ok((
+            self.config.accept.judge(score, worst, report.lost),
+            q,
+            report,
+        ))
     }
 }

@@ -474,8 +474,15 @@ impl Acquirer {
         out: &mut [Likelihood; MAX_CAMERAS],
     ) -> usize {
         let config = self.config.likelihood;
-        self.scratch
-            .likelihoods(model, cameras, frames, edges, &q[..self.n_states], &config, out)
+        self.scratch.likelihoods(
+            model,
+            cameras,
+            frames,
+            edges,
+            &q[..self.n_states],
+            &config,
+            out,
+        )
     }
 
     /// Without a region: the palm on the ray through the volume's centre, at depth `k` of

@@ -133,7 +133,10 @@ impl MultiTracker {
     /// readings of one frame (the search's leaves) for the likelihood to choose among over
     /// the frames to come. A state that cannot be posed is left out. The tracker keeps
     /// holding the first.
-    pub fn seed(&mut self, others: &[[f32; crate::config::MAX_STATES]]) -> Result<(), TrackerError> {
+    pub fn seed(
+        &mut self,
+        others: &[[f32; crate::config::MAX_STATES]],
+    ) -> Result<(), TrackerError> {
         let first = self.tracker.memory();
         let n = first.state.len();
         self.hypotheses.clear();

@@ -118,7 +118,8 @@ impl StateScorer {
         q: &[f32],
         config: &LikelihoodConfig,
     ) -> f32 {
-        self.score_cameras(model, cameras, frames, edges, q, config).0
+        self.score_cameras(model, cameras, frames, edges, q, config)
+            .0
     }
 }
 
