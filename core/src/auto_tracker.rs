@@ -34,9 +34,10 @@ use heapless::Vec;
 
 use crate::acquire::{
     AcceptConfig, AcquireConfig, Acquirer, Finder, FinderConfig, FinderStep, WorkingVolume,
+    LOCAL_VARIANTS, MAX_KEEP,
 };
 use crate::camera::Camera;
-use crate::config::{MAX_CAMERAS, MAX_STATES};
+use crate::config::{MAX_CAMERAS, MAX_HYPOTHESES, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
 use crate::hypotheses::{HypothesesConfig, Hypothesis, MultiTracker};
@@ -65,6 +66,13 @@ pub const LOCAL_REFINE_PASSES: u32 = 2;
 /// followed to the next frame, where it is refined again: a hand half back in view, or moved
 /// far from the last good state, is then closed in on over a few frames.
 pub const LOCAL_FOLLOW_SCORE: f32 = 0.8;
+
+/// How far the local re-acquisition turns the last good state's palm in its variants (rad).
+pub const LOCAL_TURN_RAD: f32 = 0.3;
+
+/// How far the local re-acquisition moves the last good state's palm in depth in its
+/// variants, as a share of its distance from the first camera.
+pub const LOCAL_DEPTH_SHARE: f32 = 0.15;
 
 /// What the tracker does once the hand has been lost for [`LOST_FRAMES_BEFORE_SEARCH`] frames.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -141,6 +149,7 @@ pub struct AutoReport {
 
 /// A hypothesis refined on this frame: its state, its mean and worst camera's likelihood
 /// score, and the tracker's report of its last pass.
+#[derive(Clone, Copy)]
 struct Refined {
     score: f32,
     worst_camera: f32,
@@ -178,6 +187,14 @@ pub struct AutoTracker {
     watch: Watch,
     /// The state at the last check the track passed (or at its start).
     vouched: heapless::Vec<f32, MAX_STATES>,
+    /// The hypotheses' parameters as configured ([`AutoTracker::set_hypotheses`]); while
+    /// confirming an acquisition the tracker carries more.
+    hypotheses: HypothesesConfig,
+    /// Tracking frames left in which the search's other leaves are carried as hypotheses
+    /// beside the accepted one ([`FinderConfig::confirm_frames`]).
+    confirm_left: u32,
+    /// The best hypothesis' scores summed over the confirming frames so far, and how many.
+    confirm_scores: (f32, u32),
 }
 
 impl AutoTracker {
@@ -210,6 +227,9 @@ impl AutoTracker {
             recovery: Recovery::Search,
             watch: Watch::new(WatchConfig::default(), largest_frame_pixels(cameras)),
             vouched: heapless::Vec::new(),
+            hypotheses: HypothesesConfig::default(),
+            confirm_left: 0,
+            confirm_scores: (0.0, 0),
         })
     }
 
@@ -245,6 +265,12 @@ impl AutoTracker {
         self.finder.set_accept(accept);
     }
 
+    /// Sets how the search's leaves are refined and judged (its acceptance thresholds
+    /// included).
+    pub fn set_finder(&mut self, config: FinderConfig) {
+        self.finder.set_config(config);
+    }
+
     /// The acceptance thresholds.
     pub fn accept(&self) -> AcceptConfig {
         self.finder.config().accept
@@ -263,7 +289,10 @@ impl AutoTracker {
     /// Sets how many hypotheses are tracked (one: the single tracker, bit for bit). Their
     /// likelihood uses the search's edge-map buffers, so its stride must be the search's.
     pub fn set_hypotheses(&mut self, config: HypothesesConfig) {
-        self.multi.set_config(config);
+        self.hypotheses = config;
+        if self.confirm_left == 0 {
+            self.multi.set_config(config);
+        }
     }
 
     /// The hypotheses carried while tracking, best first (the last frame's).
@@ -321,7 +350,42 @@ impl AutoTracker {
         edge_buffers: &mut [&mut [u8]],
     ) -> Result<AutoReport, AutoError> {
         let multi = self.multi.track(frames, edge_buffers)?;
+        let mut refuted = false;
+        if self.confirm_left > 0 {
+            self.confirm_left -= 1;
+            self.confirm_scores.0 += multi.score;
+            self.confirm_scores.1 += 1;
+            if self.confirm_left == 0 {
+                // The best of the leaves carried goes on alone (or with the configured count),
+                // unless it scored too little over the frames it was confirmed on.
+                self.multi.set_config(self.hypotheses);
+                let (sum, n) = self.confirm_scores;
+                refuted = sum / (n.max(1) as f32) < self.finder.config().confirm_min_score;
+            }
+        }
         let mut report = multi.report;
+        if refuted && self.recovery == Recovery::Search {
+            // Not the hand after all: search again from scratch.
+            self.finder.restart();
+            self.following = None;
+            self.local_left = 0;
+            self.lost_run = 0;
+            self.status = Status::Searching;
+            return Ok(AutoReport {
+                status: self.status,
+                report: FrameReport {
+                    lost: true,
+                    ..report
+                },
+                evaluated: 0,
+                leaf_score: None,
+                local: false,
+                hypotheses: multi.count,
+                best_score: multi.score,
+                switched: multi.switched,
+                watch_score: None,
+            });
+        }
         let mut watch_score = None;
         if !report.lost && self.recovery == Recovery::Search && self.watch.due() {
             let worst = self.worst_camera_score(frames, edge_buffers)?;
@@ -343,6 +407,8 @@ impl AutoTracker {
             {
                 self.finder.restart();
                 self.following = None;
+                self.confirm_left = 0;
+                self.multi.set_config(self.hypotheses);
                 self.local_left = if self.ever_tracked {
                     LOCAL_SEARCH_FRAMES
                 } else {
@@ -413,6 +479,8 @@ impl AutoTracker {
 
     /// The tracker holds the hand (refined on this frame): the status becomes `Tracking`.
     fn found(&mut self) {
+        self.confirm_left = 0;
+        self.multi.set_config(self.hypotheses);
         self.multi.adopt();
         self.watch.clear();
         self.vouched = self.multi.tracker().memory().state;
@@ -422,60 +490,115 @@ impl AutoTracker {
         self.hold_tracked();
     }
 
-    /// One frame of local re-acquisition: the last good state slid over each camera's edge
-    /// map near where it projects, and the hypothesis followed from the last frame (if any),
-    /// each refined by Gauss–Newton and scored over every camera; the best is accepted if the
-    /// acceptance test takes it, else followed to the next frame if it reaches
-    /// [`LOCAL_FOLLOW_SCORE`].
+    /// After a leaf is accepted: when [`FinderConfig::confirm_frames`] asks, the other good
+    /// leaves (`others`: the search's, or the local re-acquisition's other starts) join it as
+    /// hypotheses for that many frames, so the likelihood over several frames (and each
+    /// leaf's Gauss–Newton on each) chooses among them.
+    fn confirm(&mut self, others: &[[f32; MAX_STATES]]) -> Result<(), AutoError> {
+        let finder = *self.finder.config();
+        if finder.confirm_frames == 0 || others.is_empty() {
+            return Ok(());
+        }
+        let count = finder
+            .confirm_hypotheses
+            .max(self.hypotheses.count)
+            .min(MAX_HYPOTHESES as u8);
+        // The leaves themselves are compared: nothing sampled around them (a confirming frame
+        // costs one tracker pass and one score per leaf).
+        self.multi.set_config(HypothesesConfig {
+            count,
+            spawn_per_frame: 0,
+            keep_fingers: false,
+            ..self.hypotheses
+        });
+        self.multi.seed(others)?;
+        self.confirm_left = u32::from(finder.confirm_frames);
+        self.confirm_scores = (0.0, 0);
+        Ok(())
+    }
+
+    /// One frame of local re-acquisition: a variant of the last good state (itself on every
+    /// other frame, else turned or moved in depth: [`Acquirer::variant`]) slid over the first
+    /// camera's edge map near where it projects and placed on the frame's bright regions,
+    /// and the hypothesis followed from the last frame (if any), each refined by Gauss–Newton
+    /// and scored over every camera; the best is accepted if the acceptance test takes it,
+    /// else followed to the next frame if it reaches [`LOCAL_FOLLOW_SCORE`].
     fn local_search(
         &mut self,
         frames: &[FrameView<'_>],
         maps: &[EdgeMap<'_>],
         out: &mut AutoReport,
     ) -> Result<(), AutoError> {
+        let frame = LOCAL_SEARCH_FRAMES.saturating_sub(self.local_left);
         self.local_left = self.local_left.saturating_sub(1);
         out.local = true;
         let n = self.multi.tracker().model().n_states().min(MAX_STATES);
-        let seed = self.held;
-        let mut best: Option<Refined> = None;
-        let followed = self.following.take();
-        for c in 0..=maps.len() {
+        let k = if frame.is_multiple_of(2) {
+            0
+        } else {
+            1 + (frame / 2) % (LOCAL_VARIANTS - 1)
+        };
+        let seed = {
             let tracker = self.multi.tracker();
-            let start = match (maps.get(c), tracker.cameras().get(c).copied()) {
-                (Some(map), Some(camera)) => {
-                    let near_px = camera.width as f32 * LOCAL_WINDOW;
-                    self.finder
-                        .acquirer_mut()
-                        .place(tracker.model(), &camera, map, seed, Some(near_px))
-                        .map(|placed| placed.q)
+            self.finder.acquirer().variant(
+                tracker.cameras(),
+                &self.held,
+                k,
+                LOCAL_TURN_RAD,
+                LOCAL_DEPTH_SHARE,
+            )
+        };
+        let followed = self.following.take();
+        let mut refined: Vec<Refined, 3> = Vec::new();
+        for start in 0..3 {
+            let tracker = self.multi.tracker();
+            let q = match start {
+                0 => match (maps.first(), tracker.cameras().first().copied()) {
+                    (Some(map), Some(camera)) => {
+                        let near_px = camera.width as f32 * LOCAL_WINDOW;
+                        self.finder
+                            .acquirer_mut()
+                            .place(tracker.model(), &camera, map, seed, Some(near_px))
+                            .map(|placed| placed.q)
+                    }
+                    _ => None,
+                },
+                1 => {
+                    let mut q = seed;
+                    let cameras = tracker.cameras();
+                    let placed = self.finder.acquirer_mut().replace(
+                        tracker.model(),
+                        &cameras[..cameras.len().min(MAX_CAMERAS)],
+                        maps,
+                        &mut q,
+                    );
+                    placed.then_some(q)
                 }
                 _ => followed,
             };
-            let Some(start) = start else { continue };
-            let refined = self.refine(frames, maps, start, n)?;
+            let Some(q) = q else { continue };
+            let r = self.refine(frames, maps, q, n)?;
             out.evaluated = out.evaluated.saturating_add(1);
-            if best.as_ref().is_none_or(|b| refined.score > b.score) {
-                best = Some(refined);
-            }
+            let _ = refined.push(r);
         }
-        let Some(Refined {
-            score,
-            worst_camera,
-            q,
-            report,
-        }) = best
-        else {
+        refined.sort_unstable_by(|a, b| b.score.total_cmp(&a.score));
+        let Some(best) = refined.first() else {
             return Ok(());
         };
+        let (score, q, report) = (best.score, best.q, best.report);
         out.leaf_score = Some(score);
-        let verdict = self
-            .finder
-            .config()
-            .accept
-            .judge(score, worst_camera, report.lost);
+        let finder = *self.finder.config();
+        let verdict = finder.accept.judge(score, best.worst_camera, report.lost);
         if verdict.accepted {
+            let mut others: Vec<[f32; MAX_STATES], 3> = Vec::new();
+            for r in refined.iter().skip(1) {
+                if !r.report.lost && r.score >= finder.alternative_score {
+                    let _ = others.push(r.q);
+                }
+            }
             self.multi.tracker_mut().restart_fresh(&q[..n])?;
             self.found();
+            self.confirm(&others)?;
             out.status = Status::Tracking;
             out.report = FrameReport {
                 lost: false,
@@ -573,6 +696,11 @@ impl AutoTracker {
             }
             FinderStep::Found { verdict, report } => {
                 self.found();
+                let mut others: Vec<[f32; MAX_STATES], MAX_KEEP> = Vec::new();
+                for q in self.finder.found_leaves().iter().skip(1) {
+                    let _ = others.push(*q);
+                }
+                self.confirm(&others)?;
                 out.leaf_score = Some(verdict.score);
                 out.status = Status::Tracking;
                 out.report = FrameReport {

@@ -1,9 +1,8 @@
 //! How well the search finds the hand from nothing, over seeds of the random rigs.
 //!
 //! Each seed is rendered as `random-mono` and `random-stereo` (at `--width`, 320×240 by
-//! default) and run from no initial state through a status machine like the tracker's:
-//! Searching (the core's `Finder`: the search within its budget, then a few leaves a frame
-//! refined by Gauss–Newton and judged) → Tracking → Lost → Searching after 10 lost frames.
+//! default) and run from no initial state through the core's status machine
+//! (`AutoTracker`, what `track` and the board run): Searching → Tracking → Lost → Searching.
 //! A rig is *acquired* at frame k when frames k..k+5 are all tracked with a mean fingertip
 //! error within 10 px at 640 px wide (scaled to the width), and k < `--within`.
 //!
@@ -12,8 +11,15 @@
 //! hand-free frames (`--hand-free N`): the distributions the acceptance thresholds are set
 //! from (docs/recovery.md).
 //!
+//! With `--blackout A..B` it runs the blackout sweep instead: each seed rendered with frames
+//! A..B without the hand, tracked from its initial state; a seed is re-acquired when
+//! `HELD_FRAMES` frames in a row are tracked within the limit, starting within `--within`
+//! frames of the hand's return.
+//!
 //! ```text
 //! cargo run --release -p digiteyes-host --example acquire_probe -- --seeds 401..=440
+//! cargo run --release -p digiteyes-host --example acquire_probe -- --seeds 501..=520 \
+//!     --frames 200 --blackout 80..110
 //! ```
 
 use std::io::Write;
@@ -22,8 +28,9 @@ use std::ops::RangeInclusive;
 use anyhow::{anyhow, Result};
 use clap::Parser;
 use digiteyes_core::acquire::{
-    AcceptConfig, AcquireConfig, Acquirer, Finder, FinderConfig, FinderStep, WorkingVolume,
+    AcceptConfig, AcquireConfig, Acquirer, Finder, FinderConfig, WorkingVolume,
 };
+use digiteyes_core::auto_tracker::{AutoTracker, Status};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::frame::FrameView;
@@ -34,10 +41,6 @@ use digiteyes_core::tracker::Tracker;
 use digiteyes_host::scenarios::{render_scenario, RenderOptions};
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::TrackerConfig;
-
-/// Lost frames in a row after which the probe's status machine searches again (as the
-/// tracker's does).
-const LOST_FRAMES_BEFORE_SEARCH: u32 = 10;
 
 /// Frames a claimed hand must be held, right, to count as acquired.
 const HELD_FRAMES: usize = 5;
@@ -67,6 +70,8 @@ struct Args {
     #[arg(long)]
     tree_levels: Option<u8>,
     #[arg(long)]
+    tree_pose_levels: Option<u8>,
+    #[arg(long)]
     rounds: Option<u8>,
     #[arg(long)]
     refine_seeds: Option<u8>,
@@ -81,6 +86,21 @@ struct Args {
     passes: Option<u8>,
     #[arg(long)]
     min_score: Option<f32>,
+    /// Re-place leaves on the frame they are refined on (true/false).
+    #[arg(long)]
+    replace: Option<bool>,
+    /// Frames the accepted leaf is carried with the other leaves as hypotheses.
+    #[arg(long)]
+    confirm_frames: Option<u8>,
+    /// Hypotheses carried while confirming.
+    #[arg(long)]
+    confirm_k: Option<u8>,
+    /// Mean score over the confirming frames needed to keep the hand.
+    #[arg(long)]
+    confirm_min_score: Option<f32>,
+    /// Score a leaf refined with the accepted one needs to join it.
+    #[arg(long)]
+    alternative_score: Option<f32>,
     #[arg(long)]
     min_camera_score: Option<f32>,
     /// Write every refined leaf's judgement and true error here (CSV).
@@ -97,6 +117,23 @@ struct Args {
     /// Print each run's frame-by-frame statuses.
     #[arg(long)]
     verbose: bool,
+    /// The fingertip error (px at 640 wide, scaled to `--width`) a frame must be within to
+    /// count as right.
+    #[arg(long, default_value_t = 10.0)]
+    limit_px: f32,
+    /// Print the best hypothesis' score and tip error on frames with several hypotheses.
+    #[arg(long)]
+    trace: bool,
+    /// The blackout sweep instead: render frames A..B without the hand, track from the
+    /// initial state, and report whether each seed is re-acquired within `--within` frames
+    /// of the hand's return (use with `--frames 200`).
+    #[arg(long, value_parser = parse_span)]
+    blackout: Option<std::ops::Range<usize>>,
+}
+
+fn parse_span(s: &str) -> Result<std::ops::Range<usize>, String> {
+    let (a, b) = s.split_once("..").ok_or("A..B")?;
+    Ok(a.parse().map_err(|_| "A")?..b.parse().map_err(|_| "B")?)
 }
 
 fn parse_range(s: &str) -> Result<RangeInclusive<u64>, String> {
@@ -112,6 +149,7 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         spins: args.spins.unwrap_or(d.spins),
         coarse_poses: args.coarse_poses.unwrap_or(d.coarse_poses),
         tree_levels: args.tree_levels.unwrap_or(d.tree_levels),
+        tree_pose_levels: args.tree_pose_levels.unwrap_or(d.tree_pose_levels),
         refine_rounds: args.rounds.unwrap_or(d.refine_rounds),
         refine_seeds: args.refine_seeds.unwrap_or(d.refine_seeds),
         coarse_sampling: match args.coarse_sampling.as_deref() {
@@ -129,6 +167,11 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             min_score: args.min_score.unwrap_or(f.accept.min_score),
             min_camera_score: args.min_camera_score.unwrap_or(f.accept.min_camera_score),
         },
+        replace_leaves: args.replace.unwrap_or(f.replace_leaves),
+        confirm_frames: args.confirm_frames.unwrap_or(f.confirm_frames),
+        confirm_hypotheses: args.confirm_k.unwrap_or(f.confirm_hypotheses),
+        alternative_score: args.alternative_score.unwrap_or(f.alternative_score),
+        confirm_min_score: args.confirm_min_score.unwrap_or(f.confirm_min_score),
     };
     (acquire, finder)
 }
@@ -216,6 +259,81 @@ fn new_finder(sequence: &Sequence, base: &[f32], args: &Args) -> Result<(Tracker
     Ok((tracker, Finder::new(acquirer, finder)))
 }
 
+/// The core's status machine for `sequence`: searching from the identity palm at the origin,
+/// or (`initial`) tracking from a known state.
+fn auto_tracker(sequence: &Sequence, args: &Args, initial: Option<&[f32]>) -> Result<AutoTracker> {
+    let (acquire, finder) = configs(args);
+    let mut base = vec![0.0f32; sequence.n_states()];
+    base[0] = 1.0;
+    let mut auto = match initial {
+        None => AutoTracker::new(
+            sequence.model.clone(),
+            &sequence.cameras,
+            &base,
+            sequence.free_mask(),
+            TrackerConfig::default(),
+            acquire,
+        ),
+        Some(q) => AutoTracker::tracking(
+            sequence.model.clone(),
+            &sequence.cameras,
+            q,
+            sequence.free_mask(),
+            TrackerConfig::default(),
+            acquire,
+        ),
+    }
+    .map_err(|e| anyhow!("{e}"))?;
+    auto.set_finder(finder);
+    Ok(auto)
+}
+
+/// Frame `k` of every camera.
+fn read_frames(sequence: &Sequence, k: usize) -> Result<Vec<image::GrayImage>> {
+    (0..sequence.cameras.len())
+        .map(|c| sequence.read_frame(c, k))
+        .collect()
+}
+
+/// One frame through the status machine: its report, whether it claims the hand, and the
+/// claimed state's tip error (infinite when not claimed).
+fn step_frame(
+    sequence: &Sequence,
+    auto: &mut AutoTracker,
+    bufs: &mut [Vec<u8>],
+    k: usize,
+    truth_k: &[f32],
+) -> Result<(digiteyes_core::auto_tracker::AutoReport, bool, f32)> {
+    let images = read_frames(sequence, k)?;
+    let views: Vec<_> = images
+        .iter()
+        .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
+        .collect::<Result<_, _>>()?;
+    let mut buffers: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
+    let report = auto
+        .step(&views, &mut buffers)
+        .map_err(|e| anyhow!("{e}"))?;
+    let claimed = report.status != Status::Searching && !report.report.lost;
+    let e = if claimed {
+        tip_error_px(&sequence.model, &sequence.cameras, auto.state(), truth_k)
+    } else {
+        f32::INFINITY
+    };
+    Ok((report, claimed, e))
+}
+
+/// The character a frame's status is drawn as (`--verbose`).
+fn status_char(report: &digiteyes_core::auto_tracker::AutoReport, was: Status) -> char {
+    match (was, report.status) {
+        (Status::Searching, Status::Tracking) => 'F',
+        (_, Status::Tracking) => 't',
+        (_, Status::Lost) => 'l',
+        (_, Status::Searching) if report.local => 'L',
+        (_, Status::Searching) if report.leaf_score.is_some() => 'r',
+        (_, Status::Searching) => '.',
+    }
+}
+
 fn run(
     sequence: &Sequence,
     args: &Args,
@@ -224,13 +342,9 @@ fn run(
 ) -> Result<Run> {
     let truth = sequence.read_truth()?;
     let (acquire, _) = configs(args);
-    let mut base = vec![0.0f32; sequence.n_states()];
-    base[0] = 1.0;
-    let (mut tracker, mut finder) = new_finder(sequence, &base, args)?;
-    let limit = 10.0 * args.width as f32 / 640.0;
+    let mut auto = auto_tracker(sequence, args, None)?;
+    let limit = args.limit_px * args.width as f32 / 640.0;
     let mut bufs = buffers(&sequence.cameras, &acquire);
-    let mut searching = true;
-    let mut lost_run = 0;
     let mut good = Vec::new();
     let mut out = Run {
         acquired: None,
@@ -241,76 +355,34 @@ fn run(
     };
     let mut line = String::new();
     for k in 0..sequence.frames {
-        let images: Vec<_> = (0..sequence.cameras.len())
-            .map(|c| sequence.read_frame(c, k))
-            .collect::<Result<_>>()?;
-        let views: Vec<_> = images
-            .iter()
-            .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
-            .collect::<Result<_, _>>()?;
         let truth_k: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
-        let claimed = if searching {
-            let maps = edge_maps(&mut bufs, &views, &acquire)?;
-            let step = finder
-                .step(&mut tracker, &views, &maps)
-                .map_err(|e| anyhow!("{e}"))?;
-            if let Some((verdict, q)) = finder.last_leaf() {
+        let was = auto.status();
+        let (report, claimed, e) = step_frame(sequence, &mut auto, &mut bufs, k, &truth_k)?;
+        if was == Status::Searching && !report.local {
+            out.evaluations += u64::from(report.evaluated);
+            if report.leaf_score.is_some() {
+                out.refined += 1;
+            }
+            if let (Some((verdict, q)), Some(f)) = (auto.finder().last_leaf(), csv.as_mut()) {
                 let n = sequence.n_states();
                 let e = tip_error_px(&sequence.model, &sequence.cameras, &q[..n], &truth_k);
-                if let Some(f) = csv.as_mut() {
-                    writeln!(
-                        f,
-                        "{label},{k},{:.4},{:.4},{},{},{e:.2}",
-                        verdict.score,
-                        verdict.worst_camera,
-                        u8::from(verdict.lost),
-                        u8::from(verdict.accepted)
-                    )?;
-                }
+                writeln!(
+                    f,
+                    "{label},{k},{:.4},{:.4},{},{},{e:.2}",
+                    verdict.score,
+                    verdict.worst_camera,
+                    u8::from(verdict.lost),
+                    u8::from(verdict.accepted)
+                )?;
             }
-            match step {
-                FinderStep::Searching {
-                    evaluated, refined, ..
-                } => {
-                    out.evaluations += u64::from(evaluated);
-                    out.refined += u32::from(refined);
-                    line.push(if refined > 0 { 'r' } else { '.' });
-                    false
-                }
-                FinderStep::Found { .. } => {
-                    out.refined += 1;
-                    searching = false;
-                    lost_run = 0;
-                    line.push('F');
-                    true
-                }
-            }
-        } else {
-            let report = tracker.track(&views).map_err(|e| anyhow!("{e}"))?;
-            if report.lost {
-                lost_run += 1;
-                line.push('l');
-                if lost_run >= LOST_FRAMES_BEFORE_SEARCH {
-                    searching = true;
-                    finder.restart();
-                }
-                false
-            } else {
-                lost_run = 0;
-                line.push('t');
-                true
-            }
-        };
-        let e = if claimed {
-            tip_error_px(
-                &sequence.model,
-                &sequence.cameras,
-                tracker.state(),
-                &truth_k,
-            )
-        } else {
-            f32::INFINITY
-        };
+        }
+        line.push(status_char(&report, was));
+        if args.trace && report.hypotheses > 1 {
+            eprintln!(
+                "trace {label} {k} {} {:.4} {e:.2}",
+                report.hypotheses, report.best_score
+            );
+        }
         if claimed && out.first_claim.is_none() {
             out.first_claim = Some((k, e));
         }
@@ -326,6 +398,115 @@ fn run(
         eprintln!("{label}: {line}");
     }
     Ok(out)
+}
+
+/// One blackout run's outcome.
+struct BlackoutRun {
+    /// Tracked up to the blackout: no [`HELD_FRAMES`] frames in a row over the limit before it.
+    tracked_to_dark: bool,
+    /// Frames after the hand's return until the first of [`HELD_FRAMES`] tracked frames in a
+    /// row within the limit (when within `--within`).
+    reacquired_after: Option<usize>,
+    /// Frames without the hand that claimed it.
+    dark_claimed: usize,
+    /// Searching frames.
+    searching: usize,
+}
+
+/// Tracks `sequence` from its initial state through the blackout `dark`.
+fn blackout_run(
+    sequence: &Sequence,
+    args: &Args,
+    dark: &std::ops::Range<usize>,
+    label: &str,
+) -> Result<BlackoutRun> {
+    let truth = sequence.read_truth()?;
+    let (acquire, _) = configs(args);
+    let initial: Vec<f32> = sequence.initial_state.iter().map(|&v| v as f32).collect();
+    let mut auto = auto_tracker(sequence, args, Some(&initial))?;
+    let limit = args.limit_px * args.width as f32 / 640.0;
+    let mut bufs = buffers(&sequence.cameras, &acquire);
+    let (mut good, mut over) = (Vec::new(), Vec::new());
+    let mut out = BlackoutRun {
+        tracked_to_dark: false,
+        reacquired_after: None,
+        dark_claimed: 0,
+        searching: 0,
+    };
+    let mut line = String::new();
+    for k in 0..sequence.frames {
+        let truth_k: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
+        let was = auto.status();
+        let (report, claimed, e) = step_frame(sequence, &mut auto, &mut bufs, k, &truth_k)?;
+        line.push(status_char(&report, was));
+        if dark.contains(&k) && claimed {
+            out.dark_claimed += 1;
+        }
+        if report.status == Status::Searching {
+            out.searching += 1;
+        }
+        good.push(claimed && e <= limit);
+        over.push(!(claimed && e <= limit));
+    }
+    let a = dark.start.min(over.len());
+    out.tracked_to_dark = !(0..a.saturating_sub(HELD_FRAMES - 1))
+        .any(|k| over[k..k + HELD_FRAMES].iter().all(|&o| o));
+    out.reacquired_after = (dark.end..good.len().saturating_sub(HELD_FRAMES - 1))
+        .filter(|&k| k < dark.end + args.within)
+        .find(|&k| good[k..k + HELD_FRAMES].iter().all(|&g| g))
+        .map(|k| k - dark.end);
+    if args.verbose {
+        eprintln!("{label}: {line}");
+    }
+    Ok(out)
+}
+
+/// The blackout sweep: `random-stereo` and `random-mono` seeds through `--blackout`.
+fn blackout_sweep(args: &Args, dark: &std::ops::Range<usize>) -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let (w, h) = (args.width, args.width * 3 / 4);
+    println!("| seed | rig | tracked to the blackout | re-acquired after (frames) | dark frames claimed | searching frames |");
+    println!("|---|---|---|---|---|---|");
+    for rig in &args.rigs {
+        let mut runs = Vec::new();
+        for seed in args.seeds.clone() {
+            let seq = dir.path().join(format!("{rig}{seed}"));
+            let options = RenderOptions {
+                seed,
+                frames: Some(args.frames),
+                size: Some((w, h)),
+                blackout: Some(dark.clone()),
+                ..RenderOptions::default()
+            };
+            render_scenario(&format!("random-{rig}"), &seq, &options)?;
+            let sequence = Sequence::open(&seq)?;
+            let r = blackout_run(&sequence, args, dark, &format!("{rig}-{seed}"))?;
+            println!(
+                "| {seed} | {rig} | {} | {} | {} | {} |",
+                r.tracked_to_dark,
+                r.reacquired_after.map_or("never".into(), |k| k.to_string()),
+                r.dark_claimed,
+                r.searching
+            );
+            std::fs::remove_dir_all(&seq)?;
+            runs.push(r);
+        }
+        let tracked: Vec<&BlackoutRun> = runs.iter().filter(|r| r.tracked_to_dark).collect();
+        let mut after: Vec<usize> = tracked.iter().filter_map(|r| r.reacquired_after).collect();
+        after.sort();
+        let all: usize = runs.iter().filter(|r| r.reacquired_after.is_some()).count();
+        let claimed: usize = runs.iter().map(|r| r.dark_claimed).sum();
+        println!(
+            "{rig}: tracked to the blackout {}/{}; of those re-acquired {}/{} (frames after the \
+             return: {after:?}); re-acquired over all seeds {all}/{}; dark frames claimed {claimed}",
+            tracked.len(),
+            runs.len(),
+            after.len(),
+            tracked.len(),
+            runs.len(),
+        );
+    }
+    Ok(())
 }
 
 /// Whether the tracker started at the truth of frame `start` holds the hand within `limit`
@@ -470,6 +651,9 @@ fn hand_free_run(sequence: &Sequence, args: &Args, csv: &mut Option<std::fs::Fil
 
 fn main() -> Result<()> {
     let args = Args::parse();
+    if let Some(dark) = args.blackout.clone() {
+        return blackout_sweep(&args, &dark);
+    }
     let dir = tempfile::tempdir()?;
     let (w, h) = (args.width, args.width * 3 / 4);
     let mut csv = match &args.leaves_csv {
@@ -498,7 +682,7 @@ fn main() -> Result<()> {
             let sequence = Sequence::open(&seq)?;
             let r = run(&sequence, &args, &format!("{rig}-{seed}"), &mut csv)?;
             if args.oracle {
-                let held = oracle_holds(&sequence, 10, 10.0 * args.width as f32 / 640.0)?;
+                let held = oracle_holds(&sequence, 10, args.limit_px * args.width as f32 / 640.0)?;
                 eprintln!("{rig}-{seed}: from the truth at frame 10, held: {held}");
             }
             println!(

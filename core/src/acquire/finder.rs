@@ -28,6 +28,22 @@ pub struct FinderConfig {
     pub passes_per_leaf: u8,
     /// The acceptance thresholds.
     pub accept: AcceptConfig,
+    /// Re-place each leaf on the bright region of the frame it is refined on before
+    /// Gauss–Newton ([`Acquirer::replace`]): the search spans several frames and the hand
+    /// moves on meanwhile.
+    pub replace_leaves: bool,
+    /// Frames the status machine carries the accepted leaf together with the search's other
+    /// leaves ([`Finder::found_leaves`]) as hypotheses, the likelihood choosing among them
+    /// every frame, before it drops back to its configured count (0: none).
+    pub confirm_frames: u8,
+    /// Hypotheses carried while confirming, at most (the accepted leaf among them).
+    pub confirm_hypotheses: u8,
+    /// A leaf refined alongside the accepted one joins it as a hypothesis when it scores at
+    /// least this (and Gauss–Newton did not lose it).
+    pub alternative_score: f32,
+    /// The mean score over the confirming frames the best hypothesis needs for the hand to
+    /// be kept; under it the hand is given up and searched for again (0: always kept).
+    pub confirm_min_score: f32,
 }
 
 impl Default for FinderConfig {
@@ -37,6 +53,11 @@ impl Default for FinderConfig {
             leaves: 4,
             passes_per_leaf: 2,
             accept: AcceptConfig::default(),
+            replace_leaves: true,
+            confirm_frames: 5,
+            confirm_hypotheses: 4,
+            alternative_score: 0.85,
+            confirm_min_score: 0.0,
         }
     }
 }
@@ -72,6 +93,10 @@ pub struct Finder {
     leaves: Vec<[f32; MAX_STATES], MAX_KEEP>,
     /// The best leaf refined on the last frame, and its judgement.
     last: Option<(Verdict, [f32; MAX_STATES])>,
+    /// After [`FinderStep::Found`]: the accepted leaf, then the leaves refined with it that
+    /// scored at least [`FinderConfig::alternative_score`], then the leaves not yet refined
+    /// (best first).
+    found: Vec<[f32; MAX_STATES], MAX_KEEP>,
 }
 
 impl Finder {
@@ -82,6 +107,7 @@ impl Finder {
             config,
             leaves: Vec::new(),
             last: None,
+            found: Vec::new(),
         }
     }
 
@@ -101,6 +127,11 @@ impl Finder {
         &mut self.acquirer
     }
 
+    /// New parameters for the leaves refined from now on.
+    pub fn set_config(&mut self, config: FinderConfig) {
+        self.config = config;
+    }
+
     /// New acceptance thresholds for the leaves judged from now on.
     pub fn set_accept(&mut self, accept: AcceptConfig) {
         self.config.accept = accept;
@@ -110,6 +141,13 @@ impl Finder {
     /// leaf was refined on it.
     pub fn last_leaf(&self) -> Option<&(Verdict, [f32; MAX_STATES])> {
         self.last.as_ref()
+    }
+
+    /// After [`FinderStep::Found`], the leaves worth carrying as hypotheses: the accepted
+    /// one first (refined on the frame), then the other good refined leaves, then the
+    /// leaves not yet refined; empty otherwise.
+    pub fn found_leaves(&self) -> &[[f32; MAX_STATES]] {
+        &self.found
     }
 
     /// Starts over (the hand was lost).
@@ -128,6 +166,7 @@ impl Finder {
         edges: &[EdgeMap<'_>],
     ) -> Result<FinderStep, TrackerError> {
         self.last = None;
+        self.found.clear();
         if self.leaves.is_empty() {
             let progress = self
                 .acquirer
@@ -140,7 +179,8 @@ impl Finder {
                         // At most MAX_KEEP: cannot overflow.
                         let _ = self.leaves.push(c.q);
                     }
-                    0
+                    // What the search's last step spent on this frame.
+                    self.acquirer.last_step_cost
                 }
             };
             // The leaves are refined from the next frame on: this one's budget is spent.
@@ -151,56 +191,49 @@ impl Finder {
             });
         }
         let n = tracker.model().n_states().min(MAX_STATES);
-        let mut best: Option<(Verdict, [f32; MAX_STATES], FrameReport)> = None;
-        let mut refined = 0u8;
-        while refined < self.config.leaves_per_frame.max(1) {
-            let Some(leaf) = self.leaves.pop() else {
+        let mut refined_now: Vec<(Verdict, [f32; MAX_STATES], FrameReport), MAX_KEEP> = Vec::new();
+        while refined_now.len() < usize::from(self.config.leaves_per_frame.max(1)) {
+            let Some(mut leaf) = self.leaves.pop() else {
                 break;
             };
-            refined += 1;
-            tracker.restart_fresh(&leaf[..n])?;
-            let mut report = tracker.track(frames)?;
-            for _ in 1..self.config.passes_per_leaf.max(1) {
-                if report.lost {
-                    break;
-                }
-                // Again from where it got to, as a fresh start (no velocity from the pass).
-                let mut q = [0.0f32; MAX_STATES];
-                for (d, s) in q.iter_mut().zip(tracker.state()) {
-                    *d = *s;
-                }
-                tracker.restart_fresh(&q[..n])?;
-                report = tracker.track(frames)?;
-            }
-            let mut q = [0.0f32; MAX_STATES];
-            for (d, s) in q.iter_mut().zip(tracker.state()) {
-                *d = *s;
-            }
-            let (score, worst) = if report.lost {
-                (0.0, 0.0)
-            } else {
+            if self.config.replace_leaves {
                 let cameras = tracker.cameras();
                 let n_cameras = cameras.len().min(MAX_CAMERAS);
-                self.acquirer.score_cameras(
-                    tracker.model(),
-                    &cameras[..n_cameras],
-                    frames,
-                    edges,
-                    &q,
-                )
-            };
-            let verdict = self.config.accept.judge(score, worst, report.lost);
-            let better = best
-                .as_ref()
-                .is_none_or(|(b, _, _)| (verdict.accepted, verdict.score) > (b.accepted, b.score));
-            if better {
-                best = Some((verdict, q, report));
+                self.acquirer
+                    .replace(tracker.model(), &cameras[..n_cameras], edges, &mut leaf);
             }
+            let (verdict, q, report) = self.refine(tracker, frames, edges, &leaf, n)?;
+            // At most leaves_per_frame ≤ MAX_KEEP items are kept; a full list drops the rest.
+            let _ = refined_now.push((verdict, q, report));
         }
-        self.last = best.as_ref().map(|(v, q, _)| (*v, *q));
-        match best {
-            Some((verdict, q, report)) if verdict.accepted => {
+        let refined = refined_now.len() as u8;
+        let best = refined_now
+            .iter()
+            .enumerate()
+            .max_by(|(_, (a, _, _)), (_, (b, _, _))| {
+                (a.accepted, a.score)
+                    .partial_cmp(&(b.accepted, b.score))
+                    .unwrap_or(core::cmp::Ordering::Equal)
+            })
+            .map(|(i, _)| i);
+        self.last = best
+            .and_then(|i| refined_now.get(i))
+            .map(|(v, q, _)| (*v, *q));
+        match best.and_then(|i| refined_now.get(i).map(|b| (i, *b))) {
+            Some((i, (verdict, q, report))) if verdict.accepted => {
                 tracker.restart_fresh(&q[..n])?;
+                self.found.clear();
+                let _ = self.found.push(q);
+                for (j, (v, other, _)) in refined_now.iter().enumerate() {
+                    if j != i && !v.lost && v.score >= self.config.alternative_score {
+                        let _ = self.found.push(*other);
+                    }
+                }
+                while let Some(leaf) = self.leaves.pop() {
+                    if self.found.push(leaf).is_err() {
+                        break;
+                    }
+                }
                 self.leaves.clear();
                 Ok(FinderStep::Found { verdict, report })
             }
@@ -211,9 +244,52 @@ impl Finder {
                 Ok(FinderStep::Searching {
                     evaluated: 0,
                     refined,
-                    best_leaf: best.map(|(v, _, _)| v),
+                    best_leaf: best.map(|(_, (v, _, _))| v),
                 })
             }
         }
+    }
+
+    /// `leaf` refined by the tracker's Gauss–Newton ([`FinderConfig::passes_per_leaf`] fresh
+    /// passes on the frame), scored in every camera and judged.
+    fn refine(
+        &mut self,
+        tracker: &mut Tracker,
+        frames: &[FrameView<'_>],
+        edges: &[EdgeMap<'_>],
+        leaf: &[f32; MAX_STATES],
+        n: usize,
+    ) -> Result<(Verdict, [f32; MAX_STATES], FrameReport), TrackerError> {
+        tracker.restart_fresh(&leaf[..n])?;
+        let mut report = tracker.track(frames)?;
+        for _ in 1..self.config.passes_per_leaf.max(1) {
+            if report.lost {
+                break;
+            }
+            // Again from where it got to, as a fresh start (no velocity from the pass).
+            let mut q = [0.0f32; MAX_STATES];
+            for (d, s) in q.iter_mut().zip(tracker.state()) {
+                *d = *s;
+            }
+            tracker.restart_fresh(&q[..n])?;
+            report = tracker.track(frames)?;
+        }
+        let mut q = [0.0f32; MAX_STATES];
+        for (d, s) in q.iter_mut().zip(tracker.state()) {
+            *d = *s;
+        }
+        let (score, worst) = if report.lost {
+            (0.0, 0.0)
+        } else {
+            let cameras = tracker.cameras();
+            let n_cameras = cameras.len().min(MAX_CAMERAS);
+            self.acquirer
+                .score_cameras(tracker.model(), &cameras[..n_cameras], frames, edges, &q)
+        };
+        Ok((
+            self.config.accept.judge(score, worst, report.lost),
+            q,
+            report,
+        ))
     }
 }

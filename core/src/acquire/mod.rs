@@ -27,7 +27,7 @@ use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
-use crate::likelihood::{evaluate, EdgeMap, Likelihood, LikelihoodConfig, Region, Samples};
+use crate::likelihood::{mean_score, EdgeMap, Likelihood, LikelihoodConfig, Region, Samples};
 use crate::model::Model;
 use crate::nalgebra::{Vector2, Vector3};
 
@@ -50,6 +50,14 @@ use rotation::{axis_angle, coarse_rotation, compose};
 
 /// Chamfer look-ups a slide ([`Acquirer::place`]) may make for the cost of one evaluation.
 pub const LOOKUPS_PER_EVALUATION: u32 = 600;
+
+/// What one camera's coarse-level evaluation is charged against the budget, as a share of a
+/// full one: its cheaper score (3 points per silhouette line instead of 6, a 10×10 silhouette
+/// grid instead of 16×16) costs about half (docs/performance.md). Charged as 1 in 2.
+pub const COARSE_EVALUATION_SHARE: f32 = 0.5;
+
+/// Variants of a state [`Acquirer::variant`] gives: itself, six turns, two depths.
+pub const LOCAL_VARIANTS: u32 = 9;
 
 /// The best hypotheses kept between levels.
 pub const MAX_KEEP: usize = 8;
@@ -75,8 +83,9 @@ const COARSE_POSES: [FingerPose; POSE_COUNT] = [
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct AcquireConfig {
     /// Work per [`Acquirer::step`] at most, in evaluations: one hypothesis scored in one
-    /// camera counts 1 (a slide by [`Acquirer::place`] counts its chamfer look-ups over
-    /// [`LOOKUPS_PER_EVALUATION`]).
+    /// camera counts 1, on the coarse level's cheaper score ([`AcquireConfig::coarse_sampling`])
+    /// [`COARSE_EVALUATION_SHARE`] of one (a slide by [`Acquirer::place`] counts its chamfer
+    /// look-ups over [`LOOKUPS_PER_EVALUATION`]).
     pub evaluations_per_frame: u16,
     /// Depths tried across the volume when the first camera's frame has no bright region.
     pub depths: u8,
@@ -90,6 +99,9 @@ pub struct AcquireConfig {
     pub coarse_poses: u8,
     /// Levels of the tree after the coarse level.
     pub tree_levels: u8,
+    /// The first this many tree levels also try every pose of the library on each kept
+    /// hypothesis; the later ones only turn (and, in one camera, move) it.
+    pub tree_pose_levels: u8,
     /// First steps of the tree: palm rotation (rad), depth (share of the depth, one camera).
     pub tree_steps: [f32; 2],
     /// The coarse level's cheaper score: points per silhouette line and silhouette grid
@@ -115,6 +127,7 @@ impl Default for AcquireConfig {
             spins: 6,
             coarse_poses: 3,
             tree_levels: 3,
+            tree_pose_levels: 1,
             tree_steps: [0.35, 0.15],
             coarse_sampling: [3, 10],
             refine_rounds: 0,
@@ -172,9 +185,14 @@ pub struct Acquirer {
     pub evaluations: u32,
     /// Chamfer look-ups of the slide under way (what it costs against the budget).
     lookups: u32,
+    /// Coarse camera evaluations not yet charged (every second one is).
+    coarse_uncharged: u32,
     /// The most one hypothesis or slide has cost (evaluations): how far a step can overrun
     /// its budget, since the last item is finished once begun.
     pub largest_item_cost: u16,
+    /// What the last [`Acquirer::step`] spent against its budget (also when it ended the
+    /// search).
+    pub last_step_cost: u16,
 }
 
 impl Acquirer {
@@ -206,7 +224,9 @@ impl Acquirer {
             scratch: Scratch::new(),
             evaluations: 0,
             lookups: 0,
+            coarse_uncharged: 0,
             largest_item_cost: 0,
+            last_step_cost: 0,
         }
     }
 
@@ -222,6 +242,7 @@ impl Acquirer {
         self.best.clear();
         self.next.clear();
         self.evaluations = 0;
+        self.coarse_uncharged = 0;
     }
 
     /// The parameters.
@@ -309,12 +330,29 @@ impl Acquirer {
                 _ => self.config.likelihood,
             };
             let mut each = [Likelihood::default(); MAX_CAMERAS];
-            let n =
-                self.likelihoods_with(&likelihood, model, cameras, frames, edges, &q, &mut each);
+            let n = self.scratch.likelihoods(
+                model,
+                cameras,
+                frames,
+                edges,
+                &q[..self.n_states],
+                &likelihood,
+                &mut each,
+            );
             let score = mean_score(&each[..n]);
             keep(&mut self.next, Candidate { score, q });
-            evaluated = evaluated.saturating_add(self.finish_item(n_cameras.max(1) as u32));
+            let scored = n_cameras.max(1) as u32;
+            let charged = if matches!(self.stage, Stage::Coarse(_)) {
+                // Half of the coarse evaluations are charged, the rest carried to the next.
+                let all = self.coarse_uncharged + scored;
+                self.coarse_uncharged = all % 2;
+                all / 2
+            } else {
+                scored
+            };
+            evaluated = evaluated.saturating_add(self.finish_item(charged));
         }
+        self.last_step_cost = evaluated;
         match (self.stage, self.best.first()) {
             (Stage::Done, Some(best)) => Progress::Found(*best),
             (Stage::Done, None) => {
@@ -324,6 +362,77 @@ impl Acquirer {
             }
             _ => Progress::Searching { evaluated },
         }
+    }
+
+    /// Variant `k` of `q` for the local re-acquisition: 0 is `q` itself; 1..=6 its palm
+    /// turned by `turn_rad` either way about each of its axes; 7 and 8 its palm moved
+    /// `depth_share` nearer and farther along the first camera's ray. Variants that do not
+    /// apply (the states fixed) give `q`. `k` is taken modulo [`LOCAL_VARIANTS`].
+    pub fn variant(
+        &self,
+        cameras: &[Camera],
+        q: &[f32; MAX_STATES],
+        k: u32,
+        turn_rad: f32,
+        depth_share: f32,
+    ) -> [f32; MAX_STATES] {
+        let m = k % LOCAL_VARIANTS;
+        let mut out = *q;
+        let sign = if m.is_multiple_of(2) { -1.0 } else { 1.0 };
+        match m {
+            1..=6 if self.frees(QUATERNION) => {
+                let mut axis = [0.0f32; 3];
+                axis[((m - 1) / 2) as usize] = sign;
+                let turned = compose(&[q[0], q[1], q[2], q[3]], &axis_angle(axis, turn_rad));
+                out[..4].copy_from_slice(&turned);
+            }
+            7 | 8 if self.frees(TRANSLATION) => {
+                if let Some(camera) = cameras.first() {
+                    let eye = camera.centre();
+                    let p = Vector3::new(q[4], q[5], q[6]);
+                    let moved = eye + (p - eye) * (1.0 + sign * depth_share);
+                    out[4..7].copy_from_slice(&[moved.x, moved.y, moved.z]);
+                }
+            }
+            _ => {}
+        }
+        out
+    }
+
+    /// Moves the palm of `q` onto this frame's bright regions (`edges`' regions), its depth
+    /// kept in one camera and triangulated in two ([`place`]): a leaf found on an earlier
+    /// frame put where the hand is now. False (and `q` unchanged) when it cannot be placed
+    /// or the palm's position is not free.
+    pub fn replace(
+        &mut self,
+        model: &Model,
+        cameras: &[Camera],
+        edges: &[EdgeMap<'_>],
+        q: &mut [f32; MAX_STATES],
+    ) -> bool {
+        if !self.frees(TRANSLATION) {
+            return false;
+        }
+        let mut regions: [Option<Region>; MAX_CAMERAS] = [None; MAX_CAMERAS];
+        for (r, e) in regions.iter_mut().zip(edges) {
+            *r = e.region;
+        }
+        let n_cameras = cameras.len().min(edges.len()).min(MAX_CAMERAS);
+        let mut moved = *q;
+        let placed = place::place(
+            &mut self.scratch,
+            model,
+            &cameras[..n_cameras],
+            &regions[..n_cameras],
+            &self.volume,
+            &mut moved,
+            self.n_states,
+            Depth::Keep,
+        );
+        if placed {
+            *q = moved;
+        }
+        placed
     }
 
     /// The mean likelihood score of `q` over the cameras (0 when it cannot be posed).
@@ -348,18 +457,9 @@ impl Acquirer {
         edges: &[EdgeMap<'_>],
         q: &[f32; MAX_STATES],
     ) -> (f32, f32) {
-        let mut each = [Likelihood::default(); MAX_CAMERAS];
-        let n = self.likelihoods(model, cameras, frames, edges, q, &mut each);
-        let worst = each
-            .iter()
-            .take(n)
-            .map(|l| l.score)
-            .fold(f32::INFINITY, f32::min);
-        if n == 0 {
-            (0.0, 0.0)
-        } else {
-            (mean_score(&each[..n]), worst)
-        }
+        let config = self.config.likelihood;
+        self.scratch
+            .score_cameras(model, cameras, frames, edges, &q[..self.n_states], &config)
     }
 
     /// The likelihood of `q` in each camera into `out`; returns how many were scored (0 when
@@ -374,35 +474,15 @@ impl Acquirer {
         out: &mut [Likelihood; MAX_CAMERAS],
     ) -> usize {
         let config = self.config.likelihood;
-        self.likelihoods_with(&config, model, cameras, frames, edges, q, out)
-    }
-
-    /// [`Acquirer::likelihoods`] under `config`.
-    #[allow(clippy::too_many_arguments)]
-    fn likelihoods_with(
-        &mut self,
-        config: &LikelihoodConfig,
-        model: &Model,
-        cameras: &[Camera],
-        frames: &[FrameView<'_>],
-        edges: &[EdgeMap<'_>],
-        q: &[f32; MAX_STATES],
-        out: &mut [Likelihood; MAX_CAMERAS],
-    ) -> usize {
-        if !self.scratch.pose(model, &q[..self.n_states]) {
-            return 0;
-        }
-        let mut n = 0;
-        for (((camera, frame), edges), slot) in
-            cameras.iter().zip(frames).zip(edges).zip(out.iter_mut())
-        {
-            if !self.scratch.project(model, camera) {
-                return 0;
-            }
-            *slot = evaluate(&self.scratch.view, camera, frame, edges, config);
-            n += 1;
-        }
-        n
+        self.scratch.likelihoods(
+            model,
+            cameras,
+            frames,
+            edges,
+            &q[..self.n_states],
+            &config,
+            out,
+        )
     }
 
     /// Without a region: the palm on the ray through the volume's centre, at depth `k` of
@@ -507,10 +587,11 @@ impl Acquirer {
     }
 
     /// Counts a finished hypothesis or slide, moves the search on, and returns what it cost
-    /// against the budget: `scored` evaluations plus a slide's look-ups (at least 1).
+    /// against the budget: `scored` evaluations charged plus a slide's look-ups.
     fn finish_item(&mut self, scored: u32) -> u16 {
-        let cost = u16::try_from((scored + self.lookups / LOOKUPS_PER_EVALUATION).max(1))
-            .unwrap_or(u16::MAX);
+        // `scored` is 0 only for a coarse item whose charge is carried to the next.
+        let cost =
+            u16::try_from(scored + self.lookups / LOOKUPS_PER_EVALUATION).unwrap_or(u16::MAX);
         self.lookups = 0;
         self.largest_item_cost = self.largest_item_cost.max(cost);
         self.evaluations += 1;
@@ -639,7 +720,9 @@ impl Acquirer {
                 let moved = eye + (p - eye) * (1.0 + sign * self.config.tree_steps[1] * scale);
                 q[4..7].copy_from_slice(&[moved.x, moved.y, moved.z]);
             }
-            9.. => set_fingers(&mut q, (m - 9) as usize, self.n_states, self.free),
+            9.. if level < self.config.tree_pose_levels => {
+                set_fingers(&mut q, (m - 9) as usize, self.n_states, self.free)
+            }
             _ => return Some(None),
         }
         Some(Some(q))
@@ -695,15 +778,6 @@ impl Acquirer {
 
     fn frees(&self, range: core::ops::Range<usize>) -> bool {
         range.into_iter().all(|s| self.free.contains(s))
-    }
-}
-
-/// The mean score of `each` (0 for none).
-fn mean_score(each: &[Likelihood]) -> f32 {
-    if each.is_empty() {
-        0.0
-    } else {
-        each.iter().map(|l| l.score).sum::<f32>() / each.len() as f32
     }
 }
 

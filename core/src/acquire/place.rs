@@ -13,11 +13,9 @@
 
 use crate::camera::Camera;
 use crate::config::MAX_STATES;
-use crate::kinematics::Poses;
-use crate::likelihood::Region;
+use crate::likelihood::{Region, StateScorer};
 use crate::model::Model;
 use crate::nalgebra::{Vector2, Vector3};
-use crate::projection::ProjectedModel;
 use crate::silhouette::hand_bounds;
 
 use super::volume::WorkingVolume;
@@ -34,46 +32,10 @@ pub enum Depth {
     Keep,
 }
 
-/// Scratch of one placement: the poses and one camera's projection.
-#[derive(Debug, Clone)]
-pub(crate) struct Scratch {
-    pub(crate) poses: Option<Poses>,
-    pub(crate) view: ProjectedModel,
-}
+/// Scratch of one placement: the poses and one camera's projection (the scorer's).
+pub(crate) type Scratch = StateScorer;
 
-impl Scratch {
-    pub(crate) fn new() -> Self {
-        Scratch {
-            poses: None,
-            view: ProjectedModel::new(),
-        }
-    }
-
-    /// Poses `q` (its first `n` states); false when it cannot be posed.
-    pub(crate) fn pose(&mut self, model: &Model, q: &[f32]) -> bool {
-        match self.poses.as_mut() {
-            Some(p) => p.update(model, q).is_ok(),
-            None => match Poses::compute(model, q) {
-                Ok(p) => {
-                    self.poses = Some(p);
-                    true
-                }
-                Err(_) => false,
-            },
-        }
-    }
-
-    /// Projects the posed hand into `camera`; false when not posed.
-    pub(crate) fn project(&mut self, model: &Model, camera: &Camera) -> bool {
-        match self.poses.as_ref() {
-            Some(poses) => {
-                self.view.update(model, poses, camera, 4.0);
-                true
-            }
-            None => false,
-        }
-    }
-
+impl StateScorer {
     /// The centre and diagonal (px) of the projected hand's bounds in `camera`.
     fn bounds_in(
         &mut self,

@@ -127,6 +127,42 @@ impl MultiTracker {
         });
     }
 
+    /// Carries the tracker's present memory (first, the best) and then `others` (whole
+    /// states, one value per model state used) as the hypotheses, each of the others with
+    /// fresh memory (no motion, no silhouette reference), up to the configured count: several
+    /// readings of one frame (the search's leaves) for the likelihood to choose among over
+    /// the frames to come. A state that cannot be posed is left out. The tracker keeps
+    /// holding the first.
+    pub fn seed(
+        &mut self,
+        others: &[[f32; crate::config::MAX_STATES]],
+    ) -> Result<(), TrackerError> {
+        let first = self.tracker.memory();
+        let n = first.state.len();
+        self.hypotheses.clear();
+        let _ = self.hypotheses.push(Hypothesis {
+            memory: first.clone(),
+            report: FrameReport::default(),
+            score: 0.0,
+            age: 0,
+        });
+        for q in others {
+            if self.hypotheses.len() >= self.config.count() {
+                break;
+            }
+            if self.tracker.restart_fresh(&q[..n]).is_err() {
+                continue;
+            }
+            let _ = self.hypotheses.push(Hypothesis {
+                memory: self.tracker.memory(),
+                report: FrameReport::default(),
+                score: 0.0,
+                age: 0,
+            });
+        }
+        self.tracker.restore(&first)
+    }
+
     /// New parameters for the frames to come; the hypotheses beyond the new count are dropped.
     pub fn set_config(&mut self, config: HypothesesConfig) {
         self.config = config;

@@ -19,10 +19,12 @@ use crate::projection::ProjectedModel;
 mod edges;
 mod region;
 mod samples;
+mod state;
 
 pub use edges::{EdgeMap, EDGE_BINS, GRADIENT_STEP_PX};
 pub use region::{Region, EXTENT_PERCENTILE, MAX_EXTENT_BINS, MIN_REGION_SAMPLES};
 pub use samples::{Samples, SilhouettePoint, MAX_SAMPLES, MAX_SAMPLES_PER_LINE};
+pub use state::{mean_score, StateScorer, MIN_LINK_PX};
 
 /// Parameters of the edge map and of the score.
 #[derive(Debug, Clone, Copy, PartialEq)]
