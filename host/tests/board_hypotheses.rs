@@ -132,33 +132,37 @@ fn listen_prints_each_hypotheses_message_and_counts_them() {
 fn a_hypothesis_count_out_of_range_or_with_a_board_per_camera_is_refused_clearly() {
     let dir = tempfile::tempdir().unwrap();
     for k in ["0", "9"] {
-        let out = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
-            .args(["stream", "--port", "/nonexistent/a", "--seq", "mono"])
-            .args(["--hypotheses", k])
-            .current_dir(dir.path())
-            .output()
-            .unwrap();
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success());
+        let stderr = common::refused(
+            dir.path(),
+            &[
+                "stream",
+                "--port",
+                "/nonexistent/a",
+                "--seq",
+                "mono",
+                "--hypotheses",
+                k,
+            ],
+        );
         assert!(
             stderr.contains("--hypotheses") && stderr.contains("1..=8"),
             "K = {k}: {stderr}"
         );
     }
-    let out = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
-        .args([
+    let stderr = common::refused(
+        dir.path(),
+        &[
             "stream",
             "--port",
             "/nonexistent/a",
             "--port",
             "/nonexistent/b",
-        ])
-        .args(["--seq", "stereo", "--hypotheses", "2"])
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success());
+            "--seq",
+            "stereo",
+            "--hypotheses",
+            "2",
+        ],
+    );
     assert!(
         stderr.contains("--hypotheses") && stderr.contains("one board per camera"),
         "{stderr}"

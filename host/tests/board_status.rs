@@ -128,20 +128,20 @@ fn stream_init_auto_has_a_simulated_board_search_and_writes_the_status() {
 #[test]
 fn init_auto_with_one_board_per_camera_is_refused_clearly() {
     let dir = tempfile::tempdir().unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
-        .args([
+    let stderr = common::refused(
+        dir.path(),
+        &[
             "stream",
             "--port",
             "/nonexistent/a",
             "--port",
             "/nonexistent/b",
-        ])
-        .args(["--seq", "stereo", "--init", "auto"])
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success());
+            "--seq",
+            "stereo",
+            "--init",
+            "auto",
+        ],
+    );
     assert!(
         stderr.contains("--init auto") && stderr.contains("accepted: --init given"),
         "{stderr}"

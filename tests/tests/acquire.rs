@@ -4,10 +4,8 @@
 //! and, from no initial state, the status machine acquires the hand on random rigs the sweep
 //! says it acquires (docs/recovery.md: `acquire_probe --seeds 101..=140`).
 
-use digiteyes_core::acquire::{
-    AcquireConfig, Acquirer, Finder, FinderConfig, FinderStep, Progress, WorkingVolume,
-};
-use digiteyes_core::auto_tracker::{AutoTracker, Status};
+use digiteyes_core::acquire::{AcquireConfig, Finder, FinderConfig, FinderStep, Progress};
+use digiteyes_core::auto_tracker::Status;
 use digiteyes_core::camera::Camera;
 use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
@@ -17,6 +15,9 @@ use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::{render_scenario, RenderOptions, TrackerConfig};
+
+mod common;
+use common::search;
 
 /// A hand-free frame: the background's grey, optional noise, optional clutter (bright and
 /// dark bars at every angle), from a small deterministic generator.
@@ -79,30 +80,18 @@ fn render(dir: &std::path::Path, scenario: &str, seed: u64, frames: usize) -> Se
 /// A tracker and a finder for `sequence` from nothing: every state free, the base the
 /// identity palm at the origin.
 fn finder(sequence: &Sequence, acquire: AcquireConfig, config: FinderConfig) -> (Tracker, Finder) {
-    let mut base = vec![0.0f32; sequence.n_states()];
-    base[0] = 1.0;
-    let free = FreeMask::all(sequence.n_states());
     let tracker = Tracker::new(
         sequence.model.clone(),
         &sequence.cameras,
-        &base,
-        free,
+        &search::base(sequence.n_states()),
+        FreeMask::all(sequence.n_states()),
         TrackerConfig::default(),
     )
     .unwrap();
-    let volume = WorkingVolume::from_cameras(&sequence.cameras, 600.0);
-    let acquirer = Acquirer::new(tracker.model(), &base, free, volume, acquire);
-    (tracker, Finder::new(acquirer, config))
-}
-
-fn buffers(cameras: &[Camera], acquire: &AcquireConfig) -> Vec<Vec<u8>> {
-    cameras
-        .iter()
-        .map(|c| {
-            let (w, h) = (c.width as usize, c.height as usize);
-            vec![0u8; EdgeMap::bytes_needed(w, h, acquire.likelihood.stride_px)]
-        })
-        .collect()
+    (
+        tracker,
+        Finder::new(search::acquirer(sequence, acquire), config),
+    )
 }
 
 #[test]
@@ -122,7 +111,7 @@ fn hand_free_frames_are_never_claimed() {
             ..FinderConfig::default()
         };
         let (mut tracker, mut finder) = finder(&sequence, acquire, config);
-        let mut bufs = buffers(&sequence.cameras, &acquire);
+        let mut bufs = search::buffers(&sequence.cameras, acquire.likelihood.stride_px);
         let (mut leaves, mut best) = (0u32, 0.0f32);
         for (k, (noise, clutter)) in [(0, false), (8, false), (8, true), (0, true)]
             .into_iter()
@@ -198,17 +187,13 @@ fn the_search_keeps_its_budget_and_goes_on_where_it_left_off() {
             .collect();
         let config = AcquireConfig::default();
         let budget = config.evaluations_per_frame;
-        let mut bufs = buffers(&sequence.cameras, &config);
+        let mut bufs = search::buffers(&sequence.cameras, config.likelihood.stride_px);
         let maps: Vec<EdgeMap<'_>> = bufs
             .iter_mut()
             .zip(&views)
             .map(|(b, v)| EdgeMap::build(b, v, &config.likelihood).unwrap())
             .collect();
-        let mut base = vec![0.0f32; sequence.n_states()];
-        base[0] = 1.0;
-        let free = FreeMask::all(sequence.n_states());
-        let volume = WorkingVolume::from_cameras(&sequence.cameras, 600.0);
-        let mut acquirer = Acquirer::new(&sequence.model, &base, free, volume, config);
+        let mut acquirer = search::acquirer(&sequence, config);
         let (mut steps, mut last) = (0, 0);
         let found = loop {
             match acquirer.step(&sequence.model, &sequence.cameras, &views, &maps) {
@@ -291,19 +276,7 @@ fn the_hand_is_acquired_from_nothing_on_rigs_the_sweep_acquires() {
     ] {
         let sequence = render(dir.path(), rig, seed, 34);
         let truth = sequence.read_truth().unwrap();
-        let acquire = AcquireConfig::default();
-        let mut base = vec![0.0f32; sequence.n_states()];
-        base[0] = 1.0;
-        let mut auto = AutoTracker::new(
-            sequence.model.clone(),
-            &sequence.cameras,
-            &base,
-            sequence.free_mask(),
-            TrackerConfig::default(),
-            acquire,
-        )
-        .unwrap();
-        let mut bufs = buffers(&sequence.cameras, &acquire);
+        let (mut auto, mut bufs) = search::searching(&sequence, AcquireConfig::default());
         let (mut good, mut line) = (Vec::new(), String::new());
         for k in 0..sequence.frames {
             let images: Vec<_> = (0..sequence.cameras.len())

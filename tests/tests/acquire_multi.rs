@@ -4,12 +4,10 @@
 //! refute given up; the local re-acquisition's variants of the last good state.
 
 mod common;
+use common::search;
 
-use digiteyes_core::acquire::{
-    AcquireConfig, Acquirer, FinderConfig, WorkingVolume, LOCAL_VARIANTS,
-};
-use digiteyes_core::auto_tracker::{AutoTracker, Status};
-use digiteyes_core::camera::Camera;
+use digiteyes_core::acquire::{AcquireConfig, FinderConfig, LOCAL_VARIANTS};
+use digiteyes_core::auto_tracker::Status;
 use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
@@ -41,13 +39,6 @@ fn views(images: &[image::GrayImage]) -> Vec<FrameView<'_>> {
     images
         .iter()
         .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize).unwrap())
-        .collect()
-}
-
-fn buffers(cameras: &[Camera], stride_px: u8) -> Vec<Vec<u8>> {
-    cameras
-        .iter()
-        .map(|c| vec![0u8; EdgeMap::bytes_needed(c.width as usize, c.height as usize, stride_px)])
         .collect()
 }
 
@@ -83,7 +74,7 @@ fn seeded_hypotheses_start_fresh_are_capped_at_the_count_and_the_right_one_is_ke
         ..HypothesesConfig::default()
     };
     let mut multi = MultiTracker::new(tracker, config);
-    let mut bufs = buffers(&seq.cameras, config.likelihood.stride_px);
+    let mut bufs = search::buffers(&seq.cameras, config.likelihood.stride_px);
     let mut step = |multi: &mut MultiTracker, k: usize| {
         let images = images(&seq, k);
         let mut b: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
@@ -151,17 +142,13 @@ fn a_leaf_from_an_earlier_frame_is_placed_where_the_hand_is_now() {
         let acquire = AcquireConfig::default();
         let images = images(&sequence, 0);
         let views = views(&images);
-        let mut bufs = buffers(&sequence.cameras, acquire.likelihood.stride_px);
+        let mut bufs = search::buffers(&sequence.cameras, acquire.likelihood.stride_px);
         let maps: Vec<EdgeMap<'_>> = bufs
             .iter_mut()
             .zip(&views)
             .map(|(b, v)| EdgeMap::build(b, v, &acquire.likelihood).unwrap())
             .collect();
-        let mut base = vec![0.0f32; sequence.n_states()];
-        base[0] = 1.0;
-        let free = FreeMask::all(sequence.n_states());
-        let volume = WorkingVolume::from_cameras(&sequence.cameras, 600.0);
-        let mut acquirer = Acquirer::new(&sequence.model, &base, free, volume, acquire);
+        let mut acquirer = search::acquirer(&sequence, acquire);
         // Where the hand was some frames ago: 50 mm across the first camera's view.
         let c0 = &sequence.cameras[0];
         let across = c0.r.transpose() * digiteyes_core::nalgebra::Vector3::new(50.0, 0.0, 0.0);
@@ -186,17 +173,7 @@ fn the_local_variants_turn_and_move_the_last_good_state() {
         .map(|&v| v as f32)
         .collect();
     let q = whole(&q);
-    let mut base = vec![0.0f32; sequence.n_states()];
-    base[0] = 1.0;
-    let free = FreeMask::all(sequence.n_states());
-    let volume = WorkingVolume::from_cameras(&sequence.cameras, 600.0);
-    let acquirer = Acquirer::new(
-        &sequence.model,
-        &base,
-        free,
-        volume,
-        AcquireConfig::default(),
-    );
+    let acquirer = search::acquirer(&sequence, AcquireConfig::default());
     let eye = sequence.cameras[0].centre();
     let distance = |v: &[f32; MAX_STATES]| {
         (digiteyes_core::nalgebra::Vector3::new(v[4], v[5], v[6]) - eye).norm()
@@ -228,24 +205,8 @@ fn the_local_variants_turn_and_move_the_last_good_state() {
 /// The first frame of `sequence` the auto tracker claims the hand on, and the hypotheses it
 /// carries on that frame and the next `frames` frames.
 fn acquire(sequence: &Sequence, finder: FinderConfig, frames: usize) -> (usize, Vec<(Status, u8)>) {
-    let acquire = AcquireConfig::default();
-    let mut base = vec![0.0f32; sequence.n_states()];
-    base[0] = 1.0;
-    let mut auto = AutoTracker::new(
-        sequence.model.clone(),
-        &sequence.cameras,
-        &base,
-        sequence.free_mask(),
-        TrackerConfig::default(),
-        acquire,
-    )
-    .unwrap();
+    let (mut auto, mut bufs) = search::searching(sequence, AcquireConfig::default());
     auto.set_finder(finder);
-    let mut bufs: Vec<Vec<u8>> = sequence
-        .cameras
-        .iter()
-        .map(|c| vec![0u8; AutoTracker::edge_bytes_needed(c, &acquire)])
-        .collect();
     let mut found = None;
     let mut after = Vec::new();
     for k in 0..sequence.frames {

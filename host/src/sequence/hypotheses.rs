@@ -14,9 +14,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use digiteyes_core::config::MAX_HYPOTHESES;
 use digiteyes_core::hypotheses::Hypothesis;
-use digiteyes_core::state::renormalise_quaternion;
 
-use super::states::state_header;
+use super::states::{push_states, state_header};
 use crate::text::quote_value;
 
 /// The columns before the states.
@@ -193,12 +192,8 @@ impl HypothesesWriter {
                     self.n_states
                 );
             }
-            let mut state: Vec<f32> = state.to_vec();
-            renormalise_quaternion(&mut state);
             let mut line = format!("{frame},{rank},{},{}", h.score, h.age);
-            for v in &state {
-                line.push_str(&format!(",{v}"));
-            }
+            push_states(&mut line, state);
             self.line(&line)?;
             self.rows += 1;
         }

@@ -296,12 +296,8 @@ impl StatesWriter {
                 self.n_states
             );
         }
-        let mut state = state.to_vec();
-        renormalise_quaternion(&mut state);
         let mut line = self.frames.to_string();
-        for v in &state {
-            line.push_str(&format!(",{v}"));
-        }
+        push_states(&mut line, state);
         line.push_str(&format!(
             ",{},{},{},{},{}",
             report.rms_px,
@@ -336,6 +332,16 @@ impl StatesWriter {
     fn line(&mut self, line: &str) -> Result<()> {
         writeln!(self.out, "{line}")
             .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+}
+
+/// Appends `state` to a CSV row as `,q0,q1,…`, its quaternion normalised: how every CSV of
+/// states this command writes spells them.
+pub(crate) fn push_states(line: &mut String, state: &[f32]) {
+    let mut state = state.to_vec();
+    renormalise_quaternion(&mut state);
+    for v in &state {
+        line.push_str(&format!(",{v}"));
     }
 }
 

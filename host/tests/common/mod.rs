@@ -33,6 +33,22 @@ pub fn message<T: std::fmt::Debug>(result: anyhow::Result<T>) -> String {
     format!("{:#}", result.unwrap_err())
 }
 
+/// Runs `digiteyes ARGS` in `dir`, asserts that it fails, and returns its stderr.
+pub fn refused(dir: &Path, args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(
+        !out.status.success(),
+        "`{}` succeeded: {stderr}",
+        args.join(" ")
+    );
+    stderr
+}
+
 /// A child process, killed and reaped when dropped: a failing test leaves nothing running.
 pub struct Reap(pub std::process::Child);
 
