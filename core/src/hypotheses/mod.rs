@@ -50,6 +50,18 @@ pub struct Hypothesis {
     pub age: u32,
 }
 
+impl Hypothesis {
+    /// A hypothesis of `memory` not yet tracked on any frame: no report, unscored, age 0.
+    pub fn fresh(memory: TrackMemory) -> Self {
+        Hypothesis {
+            memory,
+            report: FrameReport::default(),
+            score: 0.0,
+            age: 0,
+        }
+    }
+}
+
 /// What one frame did.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MultiReport {
@@ -83,12 +95,7 @@ impl MultiTracker {
     /// Hypotheses around `tracker`, which starts as the only one.
     pub fn new(tracker: Tracker, config: HypothesesConfig) -> Self {
         let mut hypotheses = Vec::new();
-        let _ = hypotheses.push(Hypothesis {
-            memory: tracker.memory(),
-            report: FrameReport::default(),
-            score: 0.0,
-            age: 0,
-        });
+        let _ = hypotheses.push(Hypothesis::fresh(tracker.memory()));
         let fingers = fingers::Fingers::of(tracker.model());
         MultiTracker {
             tracker,
@@ -119,12 +126,9 @@ impl MultiTracker {
     /// Forgets every hypothesis but the tracker's present memory, which becomes the only one.
     pub fn adopt(&mut self) {
         self.hypotheses.clear();
-        let _ = self.hypotheses.push(Hypothesis {
-            memory: self.tracker.memory(),
-            report: FrameReport::default(),
-            score: 0.0,
-            age: 0,
-        });
+        let _ = self
+            .hypotheses
+            .push(Hypothesis::fresh(self.tracker.memory()));
     }
 
     /// Carries the tracker's present memory (first, the best) and then `others` (whole
@@ -139,13 +143,7 @@ impl MultiTracker {
     ) -> Result<(), TrackerError> {
         let first = self.tracker.memory();
         let n = first.state.len();
-        self.hypotheses.clear();
-        let _ = self.hypotheses.push(Hypothesis {
-            memory: first.clone(),
-            report: FrameReport::default(),
-            score: 0.0,
-            age: 0,
-        });
+        self.adopt();
         for q in others {
             if self.hypotheses.len() >= self.config.count() {
                 break;
@@ -153,12 +151,9 @@ impl MultiTracker {
             if self.tracker.restart_fresh(&q[..n]).is_err() {
                 continue;
             }
-            let _ = self.hypotheses.push(Hypothesis {
-                memory: self.tracker.memory(),
-                report: FrameReport::default(),
-                score: 0.0,
-                age: 0,
-            });
+            let _ = self
+                .hypotheses
+                .push(Hypothesis::fresh(self.tracker.memory()));
         }
         self.tracker.restore(&first)
     }
@@ -189,13 +184,7 @@ impl MultiTracker {
     /// Restarts from one hypothesis at `state`, forgetting the motion and the others.
     pub fn reset(&mut self, state: &[f32]) -> Result<(), TrackerError> {
         self.tracker.reset(state)?;
-        self.hypotheses.clear();
-        let _ = self.hypotheses.push(Hypothesis {
-            memory: self.tracker.memory(),
-            report: FrameReport::default(),
-            score: 0.0,
-            age: 0,
-        });
+        self.adopt();
         Ok(())
     }
 
