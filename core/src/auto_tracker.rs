@@ -509,6 +509,7 @@ impl AutoTracker {
             count,
             spawn_per_frame: 0,
             keep_fingers: false,
+            score_every_frames: 1,
             ..self.hypotheses
         });
         self.multi.seed(others)?;

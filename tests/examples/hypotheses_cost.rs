@@ -1,7 +1,8 @@
 //! Tracks a rendered sequence with K hypotheses, for counting instructions per frame under
 //! callgrind (`scripts/hypotheses-instructions` collects only `MultiTracker::track`).
 //!
-//! `cargo run --release -p digiteyes-tests --example hypotheses_cost -- SEQ K FRAMES`
+//! `cargo run --release -p digiteyes-tests --example hypotheses_cost -- SEQ K FRAMES [EVERY]`
+//! (EVERY: `HypothesesConfig::score_every_frames`, default 1).
 
 use anyhow::{Context, Result};
 use digiteyes_core::frame::FrameView;
@@ -16,9 +17,11 @@ fn main() -> Result<()> {
     let seq = args.first().context("SEQ K FRAMES")?;
     let k: u8 = args.get(1).context("SEQ K FRAMES")?.parse()?;
     let frames: usize = args.get(2).context("SEQ K FRAMES")?.parse()?;
+    let every: u8 = args.get(3).map_or(Ok(1), |s| s.parse())?;
     let sequence = Sequence::open(std::path::Path::new(seq))?;
     let config = HypothesesConfig {
         count: k,
+        score_every_frames: every,
         ..HypothesesConfig::default()
     };
     let tracker = sequence_tracker(&sequence, TrackerConfig::default())

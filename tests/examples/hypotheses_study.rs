@@ -3,7 +3,8 @@
 //! tracker time, then the distribution per K.
 //!
 //! `cargo run --release -p digiteyes-tests --example hypotheses_study [FRAMES [WxH [SEEDS [KS]]]]`
-//! (defaults: 120 frames, 640x480, seeds 601..=620, K 1,4; SEEDS as `A..=B`, KS as `1,2,4`).
+//! (defaults: 120 frames, 640x480, seeds 601..=620, K 1,4; SEEDS as `A..=B`, KS as `1,2,4`;
+//! `K/S` scores the hypotheses one frame in S, `HypothesesConfig::score_every_frames`).
 
 use std::time::{Duration, Instant};
 
@@ -25,12 +26,13 @@ struct Outcome {
     truth_better: (usize, usize),
 }
 
-fn track(seq: &std::path::Path, k: u8, out: &std::path::Path) -> Result<Outcome> {
+fn track(seq: &std::path::Path, (k, every): (u8, u8), out: &std::path::Path) -> Result<Outcome> {
     let sequence = Sequence::open(seq)?;
     let tracker = sequence_tracker(&sequence, TrackerConfig::default())
         .map_err(|e| anyhow::anyhow!("{e}"))?;
     let config = HypothesesConfig {
         count: k,
+        score_every_frames: every,
         ..HypothesesConfig::default()
     };
     let mut buffers: Vec<Vec<u8>> = sequence
@@ -139,9 +141,15 @@ fn main() -> Result<()> {
         }
         None => 601..=620,
     };
-    let ks: Vec<u8> = match args.get(3) {
-        Some(s) => s.split(',').map(|k| k.parse()).collect::<Result<_, _>>()?,
-        None => vec![1, 4],
+    let ks: Vec<(u8, u8)> = match args.get(3) {
+        Some(s) => s
+            .split(',')
+            .map(|k| match k.split_once('/') {
+                Some((k, every)) => Ok((k.parse()?, every.parse()?)),
+                None => Ok((k.parse()?, 1)),
+            })
+            .collect::<Result<_>>()?,
+        None => vec![(1, 1), (4, 1)],
     };
     if frames == 0 || ks.is_empty() {
         bail!("at least one frame and one K");
@@ -169,10 +177,14 @@ fn main() -> Result<()> {
             },
         )?;
         let mut line = format!("{seed:4} {}", if stereo { 2 } else { 1 });
-        for (i, &k) in ks.iter().enumerate() {
-            let o = track(&seq, k, &dir.path().join(format!("s{seed}k{k}.csv")))?;
+        for (i, &(k, every)) in ks.iter().enumerate() {
+            let o = track(
+                &seq,
+                (k, every),
+                &dir.path().join(format!("s{seed}k{k}-{every}.csv")),
+            )?;
             line += &format!(
-                " | K{k}: {:4.0}% {:5.1} {:6.1} {:6.1} {:3} truth>out {}/{}",
+                " | K{k}/{every}: {:4.0}% {:5.1} {:6.1} {:6.1} {:3} truth>out {}/{}",
                 100.0 * o.life,
                 o.joint_deg,
                 o.palm_mm,
@@ -185,7 +197,7 @@ fn main() -> Result<()> {
         }
         println!("{line}");
     }
-    for (i, &k) in ks.iter().enumerate() {
+    for (i, &(k, every)) in ks.iter().enumerate() {
         for (group, want) in [("mono", false), ("stereo", true)] {
             let rows: Vec<&Outcome> = table[i]
                 .iter()
@@ -197,7 +209,7 @@ fn main() -> Result<()> {
             }
             let held = rows.iter().filter(|o| o.life >= 0.95).count();
             println!(
-                "K={k} {group:6} seeds {:2}: life median {:4.0}%, >=95% {:3.0}%, joint median {:5.1}°, palm median {:6.1} mm, {:6.1} ms/frame",
+                "K={k}/{every} {group:6} seeds {:2}: life median {:4.0}%, >=95% {:3.0}%, joint median {:5.1}°, palm median {:6.1} mm, {:6.1} ms/frame",
                 rows.len(),
                 100.0 * median(&mut rows.iter().map(|o| o.life).collect::<Vec<_>>()),
                 100.0 * held as f64 / rows.len() as f64,

@@ -139,6 +139,62 @@ fn hypotheses_never_exceed_their_count_and_the_best_comes_first() {
     assert!(multi.track(&[view(&image)], &mut []).is_err());
 }
 
+/// Scored one frame in S: on the frames between, every hypothesis is tracked in its rank
+/// with its last score and nothing is sampled or merged; the first frame, every S-th, and
+/// every frame after one whose best was flagged lost are scored.
+#[test]
+fn hypotheses_are_scored_one_frame_in_the_period_and_carried_between() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = Sequence::open(&common::mouse(dir.path(), 13)).unwrap();
+    let every = 4u8;
+    let config = HypothesesConfig {
+        count: 3,
+        spawn_per_frame: 2,
+        score_every_frames: every,
+        ..HypothesesConfig::default()
+    };
+    let mut bufs = buffers(&seq.cameras, &config);
+    let mut multi = MultiTracker::new(sequence_tracker(&seq), config);
+    let mut last_lost = false;
+    let mut since = 0u8;
+    let (mut scored, mut carried) = (0, 0);
+    for k in 0..seq.frames {
+        let before: Vec<(f32, u32)> = multi
+            .hypotheses()
+            .iter()
+            .map(|h| (h.score, h.age))
+            .collect();
+        let image = seq.read_frame(0, k).unwrap();
+        let mut slices: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
+        let report = multi.track(&[view(&image)], &mut slices).unwrap();
+        let due = k == 0 || last_lost || since + 1 >= every;
+        let h = multi.hypotheses();
+        if due {
+            since = 0;
+            scored += 1;
+            assert!(report.sampled > 0, "frame {k}: a scored frame samples");
+            assert!(report.score > 0.0, "frame {k}: a scored frame scores");
+        } else {
+            since += 1;
+            carried += 1;
+            assert_eq!(report.sampled, 0, "frame {k}");
+            assert_eq!(report.dropped, 0, "frame {k}");
+            assert!(!report.switched, "frame {k}");
+            let after: Vec<(f32, u32)> = h.iter().map(|h| (h.score, h.age - 1)).collect();
+            assert_eq!(
+                after, before,
+                "frame {k}: ranks and scores carried, ages one more"
+            );
+        }
+        assert_eq!(multi.state(), &h[0].memory.state[..]);
+        last_lost = report.report.lost;
+    }
+    assert!(
+        scored >= 3 && carried >= 6,
+        "{scored} scored, {carried} carried"
+    );
+}
+
 /// A camera at `eye` looking at `target`, world z up in the image.
 fn look_at(eye: Vector3<f32>, target: Vector3<f32>) -> Camera {
     let forward = (target - eye).normalize();

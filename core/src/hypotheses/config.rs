@@ -61,6 +61,12 @@ pub struct HypothesesConfig {
     pub switch_margin: f32,
     /// Taken off the score of a hypothesis whose frame the tracker flagged lost.
     pub lost_penalty: f32,
+    /// The hypotheses are scored, sampled around and merged on one frame in this many
+    /// (0 and 1: every frame), and on every frame after one whose best the tracker flagged
+    /// lost; on the frames between, each is only tracked, keeping its rank and last score.
+    /// A scored frame costs the edge map of every camera, the samples' tracking and the
+    /// scores: most of what K > 1 adds to a frame (docs/hypotheses.md).
+    pub score_every_frames: u8,
     /// The image likelihood that scores them.
     pub likelihood: LikelihoodConfig,
 }
@@ -92,6 +98,7 @@ impl Default for HypothesesConfig {
             merge_distance: 0.3,
             switch_margin: 0.01,
             lost_penalty: 0.2,
+            score_every_frames: 1,
             likelihood: LikelihoodConfig::default(),
         }
     }

@@ -89,6 +89,8 @@ pub struct MultiTracker {
     hypotheses: Vec<Hypothesis, MAX_HYPOTHESES>,
     scorer: StateScorer,
     fingers: fingers::Fingers,
+    /// Frames tracked since the last scored one ([`HypothesesConfig::score_every_frames`]).
+    since_scored: u8,
 }
 
 impl MultiTracker {
@@ -103,6 +105,7 @@ impl MultiTracker {
             hypotheses,
             scorer: StateScorer::new(),
             fingers,
+            since_scored: 0,
         }
     }
 
@@ -213,6 +216,9 @@ impl MultiTracker {
         }
         if edge_buffers.len() < frames.len() {
             return Err(AutoError::BufferCount);
+        }
+        if !self.scoring_due() {
+            return self.carry(frames);
         }
         let likelihood = self.config.likelihood;
         let mut maps: Vec<EdgeMap<'_>, MAX_CAMERAS> = Vec::new();
@@ -370,6 +376,48 @@ impl MultiTracker {
             sampled,
             dropped: (candidates.len() - kept).min(usize::from(u8::MAX)) as u8,
             switched: order[0] != 0,
+        })
+    }
+
+    /// Whether this frame is scored: one in [`HypothesesConfig::score_every_frames`], the
+    /// first after a seeding, and every frame after one whose best was flagged lost.
+    fn scoring_due(&mut self) -> bool {
+        let every = self.config.score_every_frames.max(1);
+        let doubted = self.hypotheses.first().is_some_and(|h| h.report.lost);
+        let fresh = self.hypotheses.iter().all(|h| h.age == 0);
+        if doubted || fresh || self.since_scored.saturating_add(1) >= every {
+            self.since_scored = 0;
+            true
+        } else {
+            self.since_scored += 1;
+            false
+        }
+    }
+
+    /// A frame between scored ones: every hypothesis tracked, in its rank, with its last
+    /// score; nothing sampled, merged or dropped.
+    fn carry(&mut self, frames: &[FrameView<'_>]) -> Result<MultiReport, AutoError> {
+        if self.hypotheses.is_empty() {
+            self.adopt();
+        }
+        for h in self.hypotheses.iter_mut() {
+            self.tracker.restore(&h.memory)?;
+            h.report = self.tracker.track(frames)?;
+            h.memory = self.tracker.memory();
+            h.age += 1;
+        }
+        let (report, score) = match self.hypotheses.first() {
+            Some(best) => {
+                self.tracker.restore(&best.memory)?;
+                (best.report, best.score)
+            }
+            None => (FrameReport::default(), 0.0), // never: adopted above
+        };
+        Ok(MultiReport {
+            report,
+            score,
+            count: self.hypotheses.len() as u8,
+            ..MultiReport::default()
         })
     }
 }
