@@ -232,3 +232,52 @@ fn states_that_do_not_fit_the_sequence_are_refused() {
         "{err}"
     );
 }
+
+/// `eval --lost-px`: the palm moved so the fingertips are a few px off on every frame is held
+/// at the default 10 px and lost at a threshold under its error; the table and JSON say which
+/// threshold; a threshold that is not a positive number is refused.
+#[test]
+fn the_lost_threshold_is_the_callers_to_choose() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = small_sequence(dir.path(), "mouse", 8);
+    let truth = Sequence::open(&seq).unwrap().read_truth().unwrap().rows;
+    let moved: Vec<Vec<f64>> = truth
+        .iter()
+        .map(|q| {
+            let mut q = q.clone();
+            q[4] += 6.0;
+            q
+        })
+        .collect();
+    let path = seq.join("moved.csv");
+    write_truth(&path, &moved).unwrap();
+    let at_default = evaluate(&seq, &path).unwrap();
+    let error = at_default.fingertip_mean_by_frame[0];
+    assert!(error > 1.0 && error < 10.0, "{error} px");
+    assert_eq!(at_default.track_life, 1.0);
+    assert_eq!(at_default.frames_to_acquire, Some(0));
+    let strict = digiteyes_host::eval::evaluate_at(&seq, &path, error / 2.0).unwrap();
+    assert_eq!(strict.track_life, 0.0);
+    assert_eq!(strict.frames_to_acquire, None);
+    let run = |px: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_digiteyes"))
+            .args(["eval", &format!("--lost-px={px}")])
+            .arg(&seq)
+            .arg(&path)
+            .output()
+            .unwrap()
+    };
+    let out = run(&format!("{}", error / 2.0));
+    assert!(out.status.success());
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains(&format!("stays > {} px", error / 2.0)) && table.contains("0.0 %"),
+        "{table}"
+    );
+    for bad in ["0", "-3", "nan"] {
+        let out = run(bad);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{bad}");
+        assert!(stderr.contains("lost threshold"), "{bad}: {stderr}");
+    }
+}

@@ -62,8 +62,12 @@ pub struct EvalReport {
     pub palm_translation_mm: f64,
     /// Largest such distance (mm).
     pub palm_translation_max_mm: f64,
+    /// The mean fingertip error (px) above which a frame counts towards losing the track, and
+    /// below which it counts towards holding it ([`LOST_ERROR_PX`] unless asked otherwise:
+    /// `eval --lost-px`).
+    pub lost_error_px: f64,
     /// Fraction (0–1) of the frames before the track is lost: before the first frame from
-    /// which the mean fingertip error stays above [`LOST_ERROR_PX`] for [`LOST_RUN`] frames;
+    /// which the mean fingertip error stays above `lost_error_px` for [`LOST_RUN`] frames;
     /// 1 if that never happens.
     pub track_life: f64,
     /// Mean fingertip error of every frame, over all tips and cameras (px).
@@ -71,7 +75,7 @@ pub struct EvalReport {
     /// Frames the tracker flagged `lost`, when the states file has that column.
     pub lost_frames: Option<usize>,
     /// The first frame from which the hand is held: claimed (when the file says which frames
-    /// claim it) and the mean fingertip error below [`LOST_ERROR_PX`] for [`LOST_RUN`] frames;
+    /// claim it) and the mean fingertip error below `lost_error_px` for [`LOST_RUN`] frames;
     /// `None` if never.
     pub frames_to_acquire: Option<usize>,
     /// The frames where the hand was held again (as for `frames_to_acquire`) after it had
@@ -85,6 +89,16 @@ pub struct EvalReport {
 /// `frame,q0,...`) with `seq/truth.csv`. Errors if either file's frame or state count does not
 /// match the sequence.
 pub fn evaluate(seq: &Path, states_csv: &Path) -> Result<EvalReport> {
+    evaluate_at(seq, states_csv, LOST_ERROR_PX)
+}
+
+/// [`evaluate`] with a frame lost above `lost_error_px` (px) of mean fingertip error, and
+/// held below it: a threshold for another image size (10 px at 640 px wide is 5 px at 320).
+pub fn evaluate_at(seq: &Path, states_csv: &Path, lost_error_px: f64) -> Result<EvalReport> {
+    ensure!(
+        lost_error_px.is_finite() && lost_error_px > 0.0,
+        "the lost threshold must be a positive number of px, not {lost_error_px}"
+    );
     let sequence = Sequence::open(seq)?;
     let truth = sequence.read_truth()?;
     let estimated = read_states(states_csv, sequence.n_states())?;
@@ -107,6 +121,8 @@ pub fn evaluate(seq: &Path, states_csv: &Path) -> Result<EvalReport> {
             sequence.dir.join(crate::sequence::TRUTH_CSV).display()
         )
     })?;
+    report.lost_error_px = lost_error_px;
+    report.track_life = track_life_at(&report.fingertip_mean_by_frame, lost_error_px);
     report.lost_frames = estimated
         .extra("lost")
         .map(|lost| lost.iter().filter(|&&v| v != 0.0).count());
@@ -200,6 +216,7 @@ pub fn compare(
         palm_rotation_max_deg: rotation.iter().copied().fold(0.0, f64::max),
         palm_translation_mm: stats::mean(&translation),
         palm_translation_max_mm: translation.iter().copied().fold(0.0, f64::max),
+        lost_error_px: LOST_ERROR_PX,
         track_life: track_life(&by_frame),
         frames_to_acquire: acquisitions(&by_frame, &vec![true; truth.len()]).0,
         reacquired_at: acquisitions(&by_frame, &vec![true; truth.len()]).1,
@@ -213,7 +230,8 @@ impl EvalReport {
     /// Sets [`EvalReport::frames_to_acquire`] and [`EvalReport::reacquired_at`] from the
     /// fingertip errors and which frames claim the hand (one flag per frame).
     pub fn set_acquisitions(&mut self, claimed: &[bool]) {
-        let (first, again) = acquisitions(&self.fingertip_mean_by_frame, claimed);
+        let (first, again) =
+            acquisitions_at(&self.fingertip_mean_by_frame, claimed, self.lost_error_px);
         self.frames_to_acquire = first;
         self.reacquired_at = again;
     }
@@ -223,7 +241,16 @@ impl EvalReport {
 /// [`LOST_ERROR_PX`] for [`LOST_RUN`] frames — and every frame it is held again after
 /// [`LOST_RUN`] frames in a row not held. A frame past the end of `claimed` counts as claimed.
 pub fn acquisitions(errors: &[f64], claimed: &[bool]) -> (Option<usize>, Vec<usize>) {
-    let good = |k: usize| claimed.get(k).copied().unwrap_or(true) && errors[k] < LOST_ERROR_PX;
+    acquisitions_at(errors, claimed, LOST_ERROR_PX)
+}
+
+/// [`acquisitions`] with the error held below `lost_error_px` (px).
+pub fn acquisitions_at(
+    errors: &[f64],
+    claimed: &[bool],
+    lost_error_px: f64,
+) -> (Option<usize>, Vec<usize>) {
+    let good = |k: usize| claimed.get(k).copied().unwrap_or(true) && errors[k] < lost_error_px;
     let mut first = None;
     let mut again = Vec::new();
     let mut held = false;
@@ -255,12 +282,17 @@ pub fn acquisitions(errors: &[f64], claimed: &[bool]) -> (Option<usize>, Vec<usi
 /// Fraction of frames before the first run of [`LOST_RUN`] frames whose error (px) all exceed
 /// [`LOST_ERROR_PX`]; 1 if there is no such run.
 pub fn track_life(errors: &[f64]) -> f64 {
+    track_life_at(errors, LOST_ERROR_PX)
+}
+
+/// [`track_life`] with a frame lost above `lost_error_px` (px).
+pub fn track_life_at(errors: &[f64], lost_error_px: f64) -> f64 {
     if errors.is_empty() {
         return 1.0;
     }
     let mut run = 0;
     for (k, &e) in errors.iter().enumerate() {
-        run = if e > LOST_ERROR_PX { run + 1 } else { 0 };
+        run = if e > lost_error_px { run + 1 } else { 0 };
         if run == LOST_RUN {
             return (k + 1 - LOST_RUN) as f64 / errors.len() as f64;
         }

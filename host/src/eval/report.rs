@@ -2,7 +2,7 @@
 
 use std::fmt;
 
-use super::{EvalReport, LOST_ERROR_PX, LOST_RUN};
+use super::{EvalReport, LOST_RUN};
 
 impl fmt::Display for EvalReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -41,9 +41,10 @@ impl fmt::Display for EvalReport {
         let kept = (self.track_life * self.frames as f64).round() as usize;
         writeln!(
             f,
-            "track life               {:8.1} %    ({kept} of {} frames before the fingertip error stays > {LOST_ERROR_PX} px for {LOST_RUN} frames)",
+            "track life               {:8.1} %    ({kept} of {} frames before the fingertip error stays > {} px for {LOST_RUN} frames)",
             100.0 * self.track_life,
-            self.frames
+            self.frames,
+            self.lost_error_px
         )?;
         if let Some(lost) = self.lost_frames {
             writeln!(f, "frames flagged lost      {lost:8}")?;
@@ -51,11 +52,13 @@ impl fmt::Display for EvalReport {
         match self.frames_to_acquire {
             Some(k) => writeln!(
                 f,
-                "frames to acquire        {k:8}       (first frame from which the hand is claimed with the fingertip error < {LOST_ERROR_PX} px for {LOST_RUN} frames)"
+                "frames to acquire        {k:8}       (first frame from which the hand is claimed with the fingertip error < {} px for {LOST_RUN} frames)",
+                self.lost_error_px
             )?,
             None => writeln!(
                 f,
-                "frames to acquire        never    (the hand is never claimed with the fingertip error < {LOST_ERROR_PX} px for {LOST_RUN} frames)"
+                "frames to acquire        never    (the hand is never claimed with the fingertip error < {} px for {LOST_RUN} frames)",
+                self.lost_error_px
             )?,
         }
         let again = self
