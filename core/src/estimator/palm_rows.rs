@@ -3,8 +3,9 @@
 //! — the distance of each from the predicted hull edge line — through the same link Jacobian
 //! (the two box corners' derivatives by the 7 palm states).
 
-use super::reference::add_reference_rows;
-use super::{add_link_rows, EstimatorConfig, FreeMask, LinkJacobian, LinkRows, NormalEquations};
+use super::link_rows::add_weighted_link_rows;
+use super::reference::add_weighted_reference_rows;
+use super::{EstimatorConfig, FreeMask, LinkJacobian, LinkRows, NormalEquations};
 use super::ResidualKind;
 use crate::features::LinkFeatures;
 use crate::palm_outline::HullEdge;
@@ -19,7 +20,9 @@ fn palm_config(config: &EstimatorConfig) -> EstimatorConfig {
 }
 
 /// Adds the edge-point rows of one palm hull edge's features to `ne`, as
-/// [`add_link_rows`] does for a link's; `jac` is the [`LinkJacobian`] of `edge.segment`.
+/// [`add_link_rows`](super::add_link_rows) does for a link's, each weighted by
+/// `config.palm_edge_weight` besides the robust weight; `jac` is the [`LinkJacobian`] of
+/// `edge.segment`.
 pub fn add_palm_edge_rows(
     ne: &mut NormalEquations,
     edge: &HullEdge,
@@ -28,7 +31,15 @@ pub fn add_palm_edge_rows(
     config: &EstimatorConfig,
     free: FreeMask,
 ) -> LinkRows {
-    add_link_rows(ne, &edge.segment, features, jac, &palm_config(config), free)
+    add_weighted_link_rows(
+        ne,
+        &edge.segment,
+        features,
+        jac,
+        &palm_config(config),
+        free,
+        config.palm_edge_weight,
+    )
 }
 
 /// [`add_palm_edge_rows`] the plain way, one reference row at a time: the oracle.
@@ -40,5 +51,13 @@ pub fn add_reference_palm_edge_rows(
     config: &EstimatorConfig,
     free: FreeMask,
 ) -> LinkRows {
-    add_reference_rows(ne, &edge.segment, features, jac, &palm_config(config), free)
+    add_weighted_reference_rows(
+        ne,
+        &edge.segment,
+        features,
+        jac,
+        &palm_config(config),
+        free,
+        config.palm_edge_weight,
+    )
 }
