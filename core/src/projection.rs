@@ -287,8 +287,12 @@ impl ProjectedModel {
                 }
                 Shape::Box { size, centre } => {
                     if let Some(pose) = poses.frame(i) {
-                        self.palm = project_box(camera, pose.r, pose.t, size, centre)
-                            .map(|p| ProjectedPalm { frame: i as u8, ..p });
+                        self.palm = project_box(camera, pose.r, pose.t, size, centre).map(|p| {
+                            ProjectedPalm {
+                                frame: i as u8,
+                                ..p
+                            }
+                        });
                     }
                 }
                 _ => {}

@@ -390,7 +390,11 @@ fn palm_slices_are_masked_under_a_nearer_finger_and_beside_any_finger() {
         6.0,
         palm_z - 30.0,
     ));
-    assert_eq!(masked_on(&across, &camera, &frame, edge), 1, "one slice hidden");
+    assert_eq!(
+        masked_on(&across, &camera, &frame, edge),
+        1,
+        "one slice hidden"
+    );
     // The same finger farther than the palm: the edge is seen, but its outside is finger.
     let mut under = base.clone();
     let _ = under.links.push(fake_link(
@@ -400,7 +404,11 @@ fn palm_slices_are_masked_under_a_nearer_finger_and_beside_any_finger() {
         6.0,
         palm_z + 30.0,
     ));
-    assert_eq!(masked_on(&under, &camera, &frame, edge), 1, "finger far beyond");
+    assert_eq!(
+        masked_on(&under, &camera, &frame, edge),
+        1,
+        "finger far beyond"
+    );
     // Fingers beyond the edge along its whole length, just outside (the knuckle face): every
     // slice's outside is finger.
     let mut knuckles = base.clone();
@@ -411,7 +419,11 @@ fn palm_slices_are_masked_under_a_nearer_finger_and_beside_any_finger() {
         7.0,
         palm_z,
     ));
-    assert_eq!(masked_on(&knuckles, &camera, &frame, edge), 5, "knuckle face");
+    assert_eq!(
+        masked_on(&knuckles, &camera, &frame, edge),
+        5,
+        "knuckle face"
+    );
     // Fingers well clear of the edge: nothing masked.
     let mut clear = base.clone();
     let _ = clear.links.push(fake_link(

@@ -477,7 +477,11 @@ fn version_5_configure_is_a_decode_error() {
         .unwrap()
         .1;
     let frame = encode(&v6, &mut buf).unwrap();
-    assert_eq!(frame.len(), V5_CONFIGURE.len() + 1, "one byte more: the flag");
+    assert_eq!(
+        frame.len(),
+        V5_CONFIGURE.len() + 1,
+        "one byte more: the flag"
+    );
 }
 
 /// Version 4's `Configure` (no `hypotheses`), as a version 4 host sends it: a version 5 board

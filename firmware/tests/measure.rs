@@ -45,6 +45,11 @@ fn measure(frame: u32, iteration: u8, q: &[f32]) -> HostMessage<'static> {
     })
 }
 
+/// Each link's place in view, model frame and features.
+type LinkAnswers = Vec<(u8, u8, LinkFeatures)>;
+/// Each palm outline edge and its features.
+type PalmAnswers = Vec<(HullEdge, LinkFeatures)>;
+
 /// The in-process search of every link at `q`, as the tracker runs it for one camera, then
 /// of every palm outline edge.
 fn in_process(
@@ -53,7 +58,7 @@ fn in_process(
     q: &[f32],
     search: &mut CameraSearch,
     refine: bool,
-) -> (Vec<(u8, u8, LinkFeatures)>, Vec<(HullEdge, LinkFeatures)>) {
+) -> (LinkAnswers, PalmAnswers) {
     let config = TrackerConfig::default();
     let cam = camera();
     let poses = Poses::compute(model, q).unwrap();
@@ -140,7 +145,10 @@ fn a_held_frame_is_measured_as_the_in_process_search_finds_it() {
             .filter(|e| !e.is_empty())
             .map(BoardMessage::PalmEdges)
             .collect();
-        assert!(!palm_answers.is_empty(), "the palm's outline is measured too");
+        assert!(
+            !palm_answers.is_empty(),
+            "the palm's outline is measured too"
+        );
         expected.extend(palm_answers);
         let (last, edges) = replies.split_last().expect("an answer");
         let BoardMessage::Measured(done) = last else {

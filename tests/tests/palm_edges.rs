@@ -71,10 +71,12 @@ fn the_palm_outline_keeps_seed_39s_palm_where_the_fingers_lie_across_it() {
         worst_palm_deg(&seq, FRAMES, without),
     );
     eprintln!("seed 39, {FRAMES} frames from the truth: palm rotation error at most {on:.2} deg with palm edges, {off:.2} deg without");
-    assert!(off > 30.0, "without them the palm turns away (the defect): {off} deg");
+    assert!(
+        off > 30.0,
+        "without them the palm turns away (the defect): {off} deg"
+    );
     assert!(
         on + 10.0 < off,
         "with them it turns at least 10 deg less: {on} deg vs {off} deg"
     );
 }
-

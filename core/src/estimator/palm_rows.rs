@@ -5,8 +5,8 @@
 
 use super::link_rows::add_weighted_link_rows;
 use super::reference::add_weighted_reference_rows;
-use super::{EstimatorConfig, FreeMask, LinkJacobian, LinkRows, NormalEquations};
 use super::ResidualKind;
+use super::{EstimatorConfig, FreeMask, LinkJacobian, LinkRows, NormalEquations};
 use crate::features::LinkFeatures;
 use crate::palm_outline::HullEdge;
 

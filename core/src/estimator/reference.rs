@@ -173,7 +173,12 @@ pub(crate) fn add_weighted_reference_rows(
     }
     if let Some(tip) = features.tip {
         let r = tip_row(link, jac, &tip, &mut row);
-        ne.add_row(&row, r, weight * config.tip_weight * config.robust.weight(r), free);
+        ne.add_row(
+            &row,
+            r,
+            weight * config.tip_weight * config.robust.weight(r),
+            free,
+        );
         added.tips += 1;
     }
     added
