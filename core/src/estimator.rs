@@ -16,11 +16,15 @@
 //! - **axis line** (Eq. 2.17, the thesis' form): the distance of the projected model axis'
 //!   end points from the axis line fitted through a link's edge points
 //!   ([`fit_axis_line`](crate::features::fit_axis_line));
-//! - **tip** (Eq. 2.19): the distance along the axis between the predicted and found tip.
+//! - **tip** (Eq. 2.19): the distance along the axis between the predicted and found tip;
+//! - **palm edge point**: the distance of a point found across the palm box's image outline
+//!   from the predicted hull edge, an edge-point row of a radius-0 segment between two box
+//!   corners ([`add_palm_edge_rows`]).
 //!
 //! Modules: `config` (the parameters), `jacobian` ([`LinkJacobian`]), `normal`
-//! ([`NormalEquations`] and the solve), `link_rows` (the tracker's per-link blocks) and
-//! [`reference`] (the oracle rows).
+//! ([`NormalEquations`] and the solve), `link_rows` (the tracker's per-link blocks),
+//! `palm_rows` (the palm outline's, through the same blocks) and [`reference`] (the oracle
+//! rows).
 
 use nalgebra::SVector;
 
@@ -32,12 +36,14 @@ mod config;
 mod jacobian;
 mod link_rows;
 mod normal;
+mod palm_rows;
 pub mod reference;
 
 pub use config::{Conditioning, EstimatorConfig, FreeMask, ResidualKind, Robust};
 pub use jacobian::LinkJacobian;
 pub use link_rows::{add_link_rows, LinkRows};
 pub use normal::NormalEquations;
+pub use palm_rows::{add_palm_edge_rows, add_reference_palm_edge_rows};
 
 /// Applies a step to the free states of `q`, renormalises the quaternion and clamps joints to
 /// the model's ranges. Returns the largest joint-angle change (rad) and translation (mm).

@@ -19,7 +19,9 @@ use crate::projection::ProjectedModel;
 use crate::visibility::{candidates, cover_among, Cover};
 
 mod axis_line;
+mod palm;
 pub use axis_line::fit_axis_line;
+pub use palm::find_palm_edge_features;
 
 /// Which sign of intensity change, going outward across an edge, counts as an edge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -57,6 +59,9 @@ pub struct FeatureConfig {
     pub mask_occluded: bool,
     /// Search for fingertips.
     pub tips: bool,
+    /// Also slice across the palm box's own image outline ([`find_palm_edge_features`]),
+    /// so the palm's pose is seen by its edges and not only through the fingers'.
+    pub palm_edges: bool,
 }
 
 impl Default for FeatureConfig {
@@ -71,6 +76,7 @@ impl Default for FeatureConfig {
             polarity: Polarity::DarkOutside,
             mask_occluded: true,
             tips: true,
+            palm_edges: true,
         }
     }
 }

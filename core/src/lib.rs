@@ -14,6 +14,7 @@
 //! - [`camera`]: calibrated pinhole cameras and their projection derivative.
 //! - [`frame`]: a borrowed 8-bit frame and bounds-checked sub-pixel sampling.
 //! - [`features`]: the slice edge search of Sec. 4.3.1 with occlusion masking.
+//! - [`palm_outline`]: the palm box's image outline, whose edges are searched as the links' are.
 //! - [`estimator`]: residuals gathered per link into the normal equations, conditioned
 //!   Gauss–Newton solved by `LDLᵀ` (Eq. 2.22); [`estimator::reference`] is the oracle.
 //! - [`state`]: the state vector's layout (palm quaternion, translation, joints).
@@ -52,6 +53,7 @@ pub mod measurer;
 pub mod model;
 pub mod model_writer;
 pub mod motion;
+pub mod palm_outline;
 pub mod projection;
 pub mod protocol;
 pub mod quaternion;

@@ -11,6 +11,7 @@ use crate::camera::Camera;
 use crate::config::MAX_CAMERAS;
 use crate::features::{FeatureConfig, LinkFeatures};
 use crate::frame::FrameView;
+use crate::palm_outline::HullEdge;
 use crate::projection::ProjectedModel;
 use crate::search::CameraSearch;
 
@@ -29,6 +30,22 @@ pub trait Measurer {
         camera: &Camera,
         view: &ProjectedModel,
         index: usize,
+        config: &FeatureConfig,
+        refine: bool,
+        out: &mut LinkFeatures,
+    );
+
+    /// The features across the palm's hull edge `edge` of `view` (camera number
+    /// `camera_index`, at the state of this iteration) into `out`
+    /// ([`find_palm_edge_features`](crate::features::find_palm_edge_features)): empty when
+    /// the camera has nothing for it. Asked only when `config.palm_edges` is on.
+    #[allow(clippy::too_many_arguments)]
+    fn palm_edge_features(
+        &mut self,
+        camera_index: usize,
+        camera: &Camera,
+        view: &ProjectedModel,
+        edge: &HullEdge,
         config: &FeatureConfig,
         refine: bool,
         out: &mut LinkFeatures,
@@ -91,6 +108,26 @@ impl Measurer for LocalFrames<'_, '_> {
             return;
         };
         search.link(view, camera, frame, index, config, refine, out);
+    }
+
+    fn palm_edge_features(
+        &mut self,
+        camera_index: usize,
+        camera: &Camera,
+        view: &ProjectedModel,
+        edge: &HullEdge,
+        config: &FeatureConfig,
+        refine: bool,
+        out: &mut LinkFeatures,
+    ) {
+        let (Some(frame), Some(search)) = (
+            self.frames.get(camera_index),
+            self.searches.get_mut(camera_index),
+        ) else {
+            *out = LinkFeatures::default();
+            return;
+        };
+        search.palm_edge(view, camera, frame, edge, config, refine, out);
     }
 
     fn silhouette(

@@ -38,7 +38,7 @@ impl Bounds {
         p.x >= self.min.x && p.y >= self.min.y && p.x <= self.max.x && p.y <= self.max.y
     }
 
-    fn around(a: Vector2<f32>, b: Vector2<f32>, pad: f32) -> Bounds {
+    pub(crate) fn around(a: Vector2<f32>, b: Vector2<f32>, pad: f32) -> Bounds {
         Bounds {
             min: Vector2::new(a.x.min(b.x) - pad, a.y.min(b.y) - pad),
             max: Vector2::new(a.x.max(b.x) + pad, a.y.max(b.y) + pad),
@@ -140,11 +140,23 @@ impl ProjectedLink {
     }
 }
 
-/// The palm box as one camera sees it, for exact ray tests.
+/// Corners of a box: corner `k` takes the low or high bound on x, y, z by bits 0, 1, 2 of `k`.
+pub const BOX_CORNERS: usize = 8;
+
+/// The palm box as one camera sees it, for exact ray tests and its outline
+/// ([`crate::palm_outline`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProjectedPalm {
     /// Image bounds of the box's corners (px).
     pub bounds: Bounds,
+    /// The model frame the box belongs to (the palm, frame 0).
+    pub frame: u8,
+    /// The box's corners in the world (mm), numbered as [`BOX_CORNERS`] says.
+    pub corners_mm: [Vector3<f32>; BOX_CORNERS],
+    /// The corners in the image (px); every corner is in front of the camera.
+    pub corners_px: [Vector2<f32>; BOX_CORNERS],
+    /// The corners' camera depths (mm).
+    pub corners_z: [f32; BOX_CORNERS],
     /// Camera centre in the palm frame (mm).
     origin: Vector3<f32>,
     /// Maps a camera ray `((u−cx)/fx, (v−cy)/fy, 1)` to a direction in the palm frame.
@@ -275,7 +287,12 @@ impl ProjectedModel {
                 }
                 Shape::Box { size, centre } => {
                     if let Some(pose) = poses.frame(i) {
-                        self.palm = project_box(camera, pose.r, pose.t, size, centre);
+                        self.palm = project_box(camera, pose.r, pose.t, size, centre).map(|p| {
+                            ProjectedPalm {
+                                frame: i as u8,
+                                ..p
+                            }
+                        });
                     }
                 }
                 _ => {}
@@ -316,19 +333,34 @@ fn project_box(
         min: Vector2::new(f32::INFINITY, f32::INFINITY),
         max: Vector2::new(f32::NEG_INFINITY, f32::NEG_INFINITY),
     };
-    for corner in 0..8 {
+    let mut corners_mm = [Vector3::zeros(); BOX_CORNERS];
+    let mut corners_px = [Vector2::zeros(); BOX_CORNERS];
+    let mut corners_z = [0.0f32; BOX_CORNERS];
+    for (corner, ((mm, px), z)) in corners_mm
+        .iter_mut()
+        .zip(corners_px.iter_mut())
+        .zip(corners_z.iter_mut())
+        .enumerate()
+    {
         let local = Vector3::new(
             if corner & 1 == 0 { lo.x } else { hi.x },
             if corner & 2 == 0 { lo.y } else { hi.y },
             if corner & 4 == 0 { lo.z } else { hi.z },
         );
-        let uv = camera.project(&(r * local + t))?;
+        *mm = r * local + t;
+        let uv = camera.project(mm)?;
+        *px = uv;
+        *z = camera.to_camera(mm).z;
         bounds.min = bounds.min.inf(&uv);
         bounds.max = bounds.max.sup(&uv);
     }
     let rt = r.transpose();
     Some(ProjectedPalm {
         bounds,
+        frame: 0,
+        corners_mm,
+        corners_px,
+        corners_z,
         origin: rt * (camera.centre() - t),
         to_palm: rt * camera.r.transpose(),
         lo,

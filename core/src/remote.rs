@@ -1,6 +1,6 @@
 //! One board per camera, as the thesis' stereo system ran: per iteration the host sends the
 //! state ([`Measure`]), each board searches its own frame at it and answers with what it
-//! found ([`LinkEdges`] per link, then [`Measured`]), and the host fuses every camera's
+//! found ([`LinkEdges`] per link, [`PalmEdges`] per palm outline edge, then [`Measured`]), and the host fuses every camera's
 //! features in one solve. This module is the board's half ([`MeasureWork`]) and the
 //! conversions both halves share, so the host rebuilds exactly the features the in-process
 //! loop would have found.
@@ -16,8 +16,9 @@ use crate::frame::FrameView;
 use crate::kinematics::Poses;
 use crate::model::Model;
 use crate::nalgebra::Vector2;
+use crate::palm_outline::{HullEdge, PalmOutline};
 use crate::projection::ProjectedModel;
-use crate::protocol::{LinkEdges, Measure, Measured, WireEdge};
+use crate::protocol::{BoardMessage, LinkEdges, Measure, Measured, PalmEdges, WireEdge};
 use crate::search::CameraSearch;
 use crate::tracker::TrackerConfig;
 
@@ -71,6 +72,53 @@ impl LinkEdges {
     }
 }
 
+impl PalmEdges {
+    /// The wire form of `features`, found across the palm outline edge `edge` in answer to
+    /// `measure`.
+    pub fn from_features(measure: &Measure, edge: &HullEdge, features: &LinkFeatures) -> Self {
+        PalmEdges {
+            frame: measure.frame,
+            iteration: measure.iteration,
+            corners: edge.corners,
+            edges: features
+                .edges
+                .iter()
+                .map(|e| WireEdge {
+                    s: e.s,
+                    side: e.side,
+                    position: [e.position.x, e.position.y],
+                })
+                .collect(),
+            expected: features.expected,
+            masked: features.masked,
+        }
+    }
+
+    /// The features as the tracker uses them (edges and the counts).
+    pub fn to_features(&self, out: &mut LinkFeatures) {
+        out.edges.clear();
+        for e in &self.edges {
+            // At most `MAX_SLICES_PER_LINK` here, `2 · MAX_SLICES_PER_LINK` there.
+            let _ = out.edges.push(EdgePoint {
+                s: e.s,
+                side: e.side,
+                position: Vector2::new(e.position[0], e.position[1]),
+                strength: 0.0,
+            });
+        }
+        out.tip = None;
+        out.expected = self.expected;
+        out.masked = self.masked;
+        out.off_frame = 0;
+        out.reach_px = 0.0;
+    }
+
+    /// Whether the board said nothing of this edge (nothing expected, found or masked).
+    pub fn is_empty(&self) -> bool {
+        self.edges.is_empty() && self.expected == 0 && self.masked == 0
+    }
+}
+
 /// A board's working memory for answering [`Measure`]s: the same projection and coarse-to-fine
 /// search the in-process tracker runs for one camera.
 #[derive(Debug, Clone, Default)]
@@ -78,6 +126,7 @@ pub struct MeasureWork {
     poses: Option<Poses>,
     view: ProjectedModel,
     search: CameraSearch,
+    outline: PalmOutline,
     features: LinkFeatures,
 }
 
@@ -88,8 +137,10 @@ impl MeasureWork {
     }
 
     /// Answers `measure` on `frame` (camera `camera`, parameters `config`): hands `send` one
-    /// [`LinkEdges`] per link in view with anything to say, in table order, and returns the
-    /// closing [`Measured`]. An unusable state measures nothing (`links` = 0).
+    /// [`BoardMessage::LinkEdges`] per link in view with anything to say, in table order,
+    /// then (with `config.features.palm_edges`) one [`BoardMessage::PalmEdges`] per palm
+    /// outline edge with anything to say, in outline order, and returns the closing
+    /// [`Measured`]. An unusable state measures nothing (`links` = 0).
     #[inline(never)] // a stage of the stereo loop: kept whole so profiles can attribute it
     pub fn measure(
         &mut self,
@@ -98,7 +149,7 @@ impl MeasureWork {
         frame: &FrameView<'_>,
         config: &TrackerConfig,
         measure: &Measure,
-        mut send: impl FnMut(LinkEdges),
+        mut send: impl FnMut(BoardMessage),
     ) -> Measured {
         let mut answer = Measured {
             frame: measure.frame,
@@ -139,8 +190,28 @@ impl MeasureWork {
             let link = self.view.links[index].frame;
             let edges = LinkEdges::from_features(measure, index as u8, link, &self.features);
             if !edges.is_empty() {
-                send(edges);
+                send(BoardMessage::LinkEdges(edges));
                 answer.links = answer.links.saturating_add(1);
+            }
+        }
+        if config.features.palm_edges {
+            self.outline
+                .update(self.view.palm.as_ref(), config.features.min_link_px);
+            for edge in &self.outline.edges {
+                self.search.palm_edge(
+                    &self.view,
+                    camera,
+                    frame,
+                    edge,
+                    &config.features,
+                    refine,
+                    &mut self.features,
+                );
+                let edges = PalmEdges::from_features(measure, edge, &self.features);
+                if !edges.is_empty() {
+                    send(BoardMessage::PalmEdges(edges));
+                    answer.links = answer.links.saturating_add(1);
+                }
             }
         }
         if config.silhouette_grid > 0 {

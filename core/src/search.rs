@@ -7,9 +7,15 @@
 
 use crate::camera::Camera;
 use crate::config::MAX_LINKS;
-use crate::features::{find_link_features, FeatureConfig, LinkFeatures, MIN_WINDOW_SAMPLES};
+use crate::features::{
+    find_link_features, find_palm_edge_features, FeatureConfig, LinkFeatures, MIN_WINDOW_SAMPLES,
+};
 use crate::frame::FrameView;
-use crate::projection::ProjectedModel;
+use crate::palm_outline::HullEdge;
+use crate::projection::{ProjectedModel, BOX_CORNERS};
+
+/// Pairs of box corners a palm hull edge may join, numbered `8 · low + high`.
+const CORNER_PAIRS: usize = BOX_CORNERS * BOX_CORNERS;
 
 /// The reach of each link's last search in the current frame.
 #[derive(Debug, Clone, Copy)]
@@ -17,6 +23,9 @@ pub struct CameraSearch {
     /// `reach_px[link]`: how far from its prediction the last search of model link `link`
     /// found something ([`LinkFeatures::reach_px`], px); infinite when unknown.
     reach_px: [f32; MAX_LINKS],
+    /// `palm_reach_px[8 · low + high]`: the same for the palm's hull edge joining box corners
+    /// `low` < `high` (px); infinite when unknown.
+    palm_reach_px: [f32; CORNER_PAIRS],
 }
 
 impl Default for CameraSearch {
@@ -30,12 +39,14 @@ impl CameraSearch {
     pub const fn new() -> Self {
         CameraSearch {
             reach_px: [f32::INFINITY; MAX_LINKS],
+            palm_reach_px: [f32::INFINITY; CORNER_PAIRS],
         }
     }
 
     /// Forgets the reaches: the next searches use the configured windows (a new frame).
     pub fn restart(&mut self) {
         self.reach_px = [f32::INFINITY; MAX_LINKS];
+        self.palm_reach_px = [f32::INFINITY; CORNER_PAIRS];
     }
 
     /// Searches link `index` of `view` on `frame` into `out`. With `refine`, the window is
@@ -56,18 +67,12 @@ impl CameraSearch {
             .links
             .get(index)
             .map_or(usize::MAX, |l| usize::from(l.frame));
-        let mut features = *config;
-        if refine {
-            let reach = self
-                .reach_px
-                .get(link_frame)
-                .copied()
-                .unwrap_or(f32::INFINITY);
-            let need = 2.0 * (reach + features.refine_margin_px) + MIN_WINDOW_SAMPLES as f32;
-            if need < f32::from(features.window_px) {
-                features.window_px = libm::ceilf(need) as u8;
-            }
-        }
+        let reach = self
+            .reach_px
+            .get(link_frame)
+            .copied()
+            .unwrap_or(f32::INFINITY);
+        let features = narrowed(config, refine, reach);
         find_link_features(view, camera, frame, index, &features, out);
         let found = out.edges.len() as u16 + u16::from(out.tip.is_some());
         if let Some(r) = self.reach_px.get_mut(link_frame) {
@@ -79,4 +84,52 @@ impl CameraSearch {
         }
         found
     }
+
+    /// Searches the palm's hull edge `edge` of `view` on `frame` into `out`
+    /// ([`find_palm_edge_features`]), narrowing the window with `refine` as
+    /// [`CameraSearch::link`] does, by what the last search of the edge between the same two
+    /// box corners needed. Returns the edge points found.
+    #[allow(clippy::too_many_arguments)]
+    pub fn palm_edge(
+        &mut self,
+        view: &ProjectedModel,
+        camera: &Camera,
+        frame: &FrameView<'_>,
+        edge: &HullEdge,
+        config: &FeatureConfig,
+        refine: bool,
+        out: &mut LinkFeatures,
+    ) -> u16 {
+        let [c0, c1] = edge.corners;
+        let pair = usize::from(c0.min(c1)) * BOX_CORNERS + usize::from(c0.max(c1));
+        let reach = self
+            .palm_reach_px
+            .get(pair)
+            .copied()
+            .unwrap_or(f32::INFINITY);
+        let features = narrowed(config, refine, reach);
+        find_palm_edge_features(view, camera, frame, edge, &features, out);
+        let found = out.edges.len() as u16;
+        if let Some(r) = self.palm_reach_px.get_mut(pair) {
+            *r = if found == 0 {
+                f32::INFINITY
+            } else {
+                out.reach_px
+            };
+        }
+        found
+    }
+}
+
+/// `config` with the window narrowed, when `refine`, to a last search's `reach_px` plus the
+/// margin each side (never wider than configured).
+fn narrowed(config: &FeatureConfig, refine: bool, reach_px: f32) -> FeatureConfig {
+    let mut features = *config;
+    if refine {
+        let need = 2.0 * (reach_px + features.refine_margin_px) + MIN_WINDOW_SAMPLES as f32;
+        if need < f32::from(features.window_px) {
+            features.window_px = libm::ceilf(need) as u8;
+        }
+    }
+    features
 }

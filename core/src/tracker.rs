@@ -1,9 +1,10 @@
 //! The per-frame tracking loop (Sec. 4.3.2) and its report.
 //!
 //! For each frame: optionally predict the start state by constant velocity, then `iterations`
-//! times — pose the links, project them into every camera, find slice features again, add the
-//! residual rows of every camera to one set of normal equations (Sec. 2.5.5), take the
-//! conditioned Gauss–Newton step.
+//! times — pose the links, project them into every camera, find slice features again (across
+//! every link and, with `palm_edges`, across the palm box's image outline), add the residual
+//! rows of every camera to one set of normal equations (Sec. 2.5.5), take the conditioned
+//! Gauss–Newton step.
 
 use core::fmt;
 
@@ -12,7 +13,8 @@ use heapless::Vec;
 use crate::camera::{Camera, CameraError};
 use crate::config::{MAX_CAMERAS, MAX_STATES};
 use crate::estimator::{
-    add_link_rows, apply_step, EstimatorConfig, FreeMask, LinkJacobian, NormalEquations,
+    add_link_rows, add_palm_edge_rows, apply_step, EstimatorConfig, FreeMask, LinkJacobian,
+    NormalEquations,
 };
 use crate::features::{FeatureConfig, LinkFeatures};
 use crate::frame::{FrameError, FrameView};
@@ -20,6 +22,7 @@ use crate::kinematics::{KinematicsError, Poses};
 use crate::measurer::{LocalFrames, Measurer};
 use crate::model::Model;
 use crate::motion::{velocity_trust, MotionConfig};
+use crate::palm_outline::PalmOutline;
 use crate::projection::ProjectedModel;
 use crate::state::{clamp_to_limit, renormalise_quaternion, TRANSLATION};
 
@@ -158,6 +161,7 @@ impl core::error::Error for TrackerError {}
 struct Workspace {
     poses: Poses,
     views: [ProjectedModel; MAX_CAMERAS],
+    outline: PalmOutline,
     features: LinkFeatures,
     jacobian: LinkJacobian,
     normal: NormalEquations,
@@ -221,6 +225,7 @@ impl Tracker {
             work: Workspace {
                 poses,
                 views: Default::default(),
+                outline: PalmOutline::new(),
                 features: LinkFeatures::default(),
                 jacobian: LinkJacobian::default(),
                 normal: NormalEquations::new(),
@@ -535,6 +540,39 @@ impl Tracker {
                 add_link_rows(
                     &mut work.normal,
                     link,
+                    &work.features,
+                    &work.jacobian,
+                    &config.estimator,
+                    self.free,
+                );
+            }
+            if !config.features.palm_edges {
+                continue;
+            }
+            work.outline
+                .update(view.palm.as_ref(), config.features.min_link_px);
+            for edge in &work.outline.edges {
+                measurer.palm_edge_features(
+                    camera_index,
+                    camera,
+                    view,
+                    edge,
+                    &config.features,
+                    refine,
+                    &mut work.features,
+                );
+                let found = work.features.edges.len() as u16;
+                report.features_found += found;
+                report.features_expected += work.features.expected;
+                report.features_masked += work.features.masked;
+                if found == 0 {
+                    continue;
+                }
+                work.jacobian
+                    .compute(&self.model, &work.poses, camera, &edge.segment);
+                add_palm_edge_rows(
+                    &mut work.normal,
+                    edge,
                     &work.features,
                     &work.jacobian,
                     &config.estimator,

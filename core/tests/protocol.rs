@@ -126,6 +126,21 @@ fn board_messages() -> std::vec::Vec<BoardMessage> {
             silhouette: Some(f32::NAN),
         }),
         BoardMessage::Ack(Command::Hold),
+        // The largest palm outline answer: a slice's edge each, worst-case varints (version 6).
+        BoardMessage::PalmEdges(PalmEdges {
+            frame: u32::MAX,
+            iteration: u8::MAX,
+            corners: [7, 6],
+            edges: (0..digiteyes_core::config::MAX_SLICES_PER_LINK)
+                .map(|i| WireEdge {
+                    s: i as f32 / 7.0,
+                    side: 1,
+                    position: [f32::MAX, f32::MIN],
+                })
+                .collect(),
+            expected: u16::MAX,
+            masked: u16::MAX,
+        }),
         // The largest Hypotheses: every hypothesis a board carries, each with every state a
         // message carries, worst-case varints (version 5).
         largest_hypotheses(),

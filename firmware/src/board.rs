@@ -294,9 +294,9 @@ where
             &view,
             &setup.config,
             measure,
-            |edges| {
+            |message| {
                 if failed.is_none() {
-                    if let Err(e) = send_on(serial, tx, stats, &BoardMessage::LinkEdges(edges)) {
+                    if let Err(e) = send_on(serial, tx, stats, &message) {
                         failed = Some(e);
                     }
                 }

@@ -10,6 +10,7 @@ use digiteyes_core::features::LinkFeatures;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Model;
+use digiteyes_core::palm_outline::{HullEdge, PalmOutline};
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_core::protocol::*;
 use digiteyes_core::search::CameraSearch;
@@ -44,14 +45,20 @@ fn measure(frame: u32, iteration: u8, q: &[f32]) -> HostMessage<'static> {
     })
 }
 
-/// The in-process search of every link at `q`, as the tracker runs it for one camera.
+/// Each link's place in view, model frame and features.
+type LinkAnswers = Vec<(u8, u8, LinkFeatures)>;
+/// Each palm outline edge and its features.
+type PalmAnswers = Vec<(HullEdge, LinkFeatures)>;
+
+/// The in-process search of every link at `q`, as the tracker runs it for one camera, then
+/// of every palm outline edge.
 fn in_process(
     model: &Model,
     pixels: &[u8],
     q: &[f32],
     search: &mut CameraSearch,
     refine: bool,
-) -> Vec<(u8, u8, LinkFeatures)> {
+) -> (LinkAnswers, PalmAnswers) {
     let config = TrackerConfig::default();
     let cam = camera();
     let poses = Poses::compute(model, q).unwrap();
@@ -64,7 +71,15 @@ fn in_process(
         search.link(&view, &cam, &frame, index, &config.features, refine, &mut f);
         out.push((index as u8, view.links[index].frame, f));
     }
-    out
+    let mut outline = PalmOutline::new();
+    outline.update(view.palm.as_ref(), config.features.min_link_px);
+    let mut palm = Vec::new();
+    for edge in &outline.edges {
+        let mut f = LinkFeatures::default();
+        search.palm_edge(&view, &cam, &frame, edge, &config.features, refine, &mut f);
+        palm.push((*edge, f));
+    }
+    (out, palm)
 }
 
 #[test]
@@ -112,19 +127,29 @@ fn a_held_frame_is_measured_as_the_in_process_search_finds_it() {
         board.serial_mut().send(&measure(7, iteration, &guess));
         board.poll().unwrap();
         let replies = board.serial_mut().received();
-        let reference = in_process(&model, &pixels, &guess, &mut search, iteration > 0);
-        let expected: Vec<LinkEdges> = reference
+        let (reference, palm) = in_process(&model, &pixels, &guess, &mut search, iteration > 0);
+        let m = Measure {
+            frame: 7,
+            iteration,
+            q: guess.iter().copied().collect(),
+        };
+        let mut expected: Vec<BoardMessage> = reference
             .iter()
-            .map(|(index, link, f)| {
-                let m = Measure {
-                    frame: 7,
-                    iteration,
-                    q: guess.iter().copied().collect(),
-                };
-                LinkEdges::from_features(&m, *index, *link, f)
-            })
+            .map(|(index, link, f)| LinkEdges::from_features(&m, *index, *link, f))
             .filter(|e| !e.is_empty())
+            .map(BoardMessage::LinkEdges)
             .collect();
+        let palm_answers: Vec<BoardMessage> = palm
+            .iter()
+            .map(|(edge, f)| PalmEdges::from_features(&m, edge, f))
+            .filter(|e| !e.is_empty())
+            .map(BoardMessage::PalmEdges)
+            .collect();
+        assert!(
+            !palm_answers.is_empty(),
+            "the palm's outline is measured too"
+        );
+        expected.extend(palm_answers);
         let (last, edges) = replies.split_last().expect("an answer");
         let BoardMessage::Measured(done) = last else {
             panic!("ends with Measured: {last:?}");
@@ -136,11 +161,12 @@ fn a_held_frame_is_measured_as_the_in_process_search_finds_it() {
         assert_eq!(edges.len(), expected.len(), "iteration {iteration}");
         let mut found = 0;
         for (got, want) in edges.iter().zip(&expected) {
-            let BoardMessage::LinkEdges(got) = got else {
-                panic!("LinkEdges before Measured: {got:?}");
-            };
             assert_eq!(got, want, "iteration {iteration}");
-            found += got.edges.len();
+            match got {
+                BoardMessage::LinkEdges(e) => found += e.edges.len(),
+                BoardMessage::PalmEdges(_) => {}
+                other => panic!("LinkEdges and PalmEdges before Measured: {other:?}"),
+            }
         }
         assert!(found > 20, "the frame shows the hand: {found} edges");
     }

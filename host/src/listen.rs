@@ -197,6 +197,14 @@ pub fn describe(message: &BoardMessage) -> String {
             e.edges.len(),
             if e.tip.is_some() { ", tip" } else { "" }
         ),
+        BoardMessage::PalmEdges(e) => format!(
+            "palm edges {} (iteration {}): outline edge from corner {} to {}, {} edges",
+            e.frame,
+            e.iteration,
+            e.corners[0],
+            e.corners[1],
+            e.edges.len()
+        ),
         BoardMessage::Hypotheses(h) => {
             let each: Vec<String> = h
                 .hypotheses

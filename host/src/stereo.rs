@@ -1,7 +1,8 @@
 //! `digiteyes stream --port A --port B`: one board per camera, one hand, as the thesis' stereo
 //! system ran (Sec. 4.3): each board holds its camera's frames; per Gauss–Newton iteration
 //! the host sends the state to every board (`Measure`), each searches its own frame at it and
-//! answers with what every link showed (`LinkEdges` …, `Measured`), and the host fuses all of
+//! answers with what every link and palm outline edge showed (`LinkEdges` …, `PalmEdges` …,
+//! `Measured`), and the host fuses all of
 //! it in one solve — the same tracker loop as `track`, fed through a
 //! [`Measurer`](digiteyes_core::measurer::Measurer) — then sends the new state back.
 //!
@@ -9,7 +10,8 @@
 //! host                                      board (one per camera)
 //!  Configure, Reset, Hold ─────────────────▶  Ack …, Ack(Hold)
 //!  FrameChunk × n (frame k) ───────────────▶  (held)
-//!  Measure(k, iteration 0, q) ─────────────▶  LinkEdges × links, Measured(k, 0)
+//!  Measure(k, iteration 0, q) ─────────────▶  LinkEdges × links, PalmEdges × edges,
+//!                                              Measured(k, 0)
 //!  Measure(k, iteration 1, q') ────────────▶  …
 //! ```
 //!
@@ -30,8 +32,11 @@ use digiteyes_core::camera::Camera;
 use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::features::{FeatureConfig, LinkFeatures};
 use digiteyes_core::measurer::Measurer;
+use digiteyes_core::palm_outline::{HullEdge, MAX_HULL_EDGES};
 use digiteyes_core::projection::ProjectedModel;
-use digiteyes_core::protocol::{BoardMessage, HostMessage, LinkEdges, Measure, TrackerParams};
+use digiteyes_core::protocol::{
+    BoardMessage, HostMessage, LinkEdges, Measure, PalmEdges, TrackerParams,
+};
 use digiteyes_core::status::Status;
 use digiteyes_core::tracker::TrackerConfig;
 
@@ -173,6 +178,8 @@ struct BoardCamera {
     figures: BoardFigures,
     /// This iteration's answer: `LinkEdges` by their index in view.
     links: Vec<Option<LinkEdges>>,
+    /// ... and `PalmEdges`, in the order they came (at most one per outline edge).
+    palm: Vec<PalmEdges>,
     silhouette: Option<f32>,
     /// A `Measure` went out this iteration and its answer is awaited.
     awaiting: bool,
@@ -183,6 +190,7 @@ struct BoardCamera {
 impl BoardCamera {
     fn clear_answer(&mut self) {
         self.links.iter_mut().for_each(|l| *l = None);
+        self.palm.clear();
         self.silhouette = None;
     }
 
@@ -204,6 +212,12 @@ impl BoardCamera {
                     let index = usize::from(e.index);
                     if let Some(slot) = self.links.get_mut(index) {
                         *slot = Some(e);
+                    }
+                }
+                BoardMessage::PalmEdges(e) if e.frame == frame && e.iteration == iteration => {
+                    self.figures.answer_bytes_down += bytes;
+                    if self.palm.len() < MAX_HULL_EDGES {
+                        self.palm.push(e);
                     }
                 }
                 BoardMessage::Measured(m) if m.frame == frame && m.iteration == iteration => {
@@ -327,6 +341,26 @@ impl Measurer for Boards<'_> {
         }
     }
 
+    fn palm_edge_features(
+        &mut self,
+        camera_index: usize,
+        _camera: &Camera,
+        _view: &ProjectedModel,
+        edge: &HullEdge,
+        _config: &FeatureConfig,
+        _refine: bool,
+        out: &mut LinkFeatures,
+    ) {
+        let answer = self
+            .boards
+            .get(camera_index)
+            .and_then(|b| b.palm.iter().find(|p| p.corners == edge.corners));
+        match answer {
+            Some(edges) => edges.to_features(out),
+            None => *out = LinkFeatures::default(),
+        }
+    }
+
     fn silhouette(
         &mut self,
         camera_index: usize,
@@ -381,6 +415,7 @@ pub fn stream_stereo(seq: &Path, out_csv: &Path, options: &StereoOptions) -> Res
                 ..BoardFigures::default()
             },
             links: vec![None; digiteyes_core::config::MAX_LINKS],
+            palm: Vec::with_capacity(MAX_HULL_EDGES),
             silhouette: None,
             awaiting: false,
             answered_this_frame: false,

@@ -19,11 +19,21 @@ fn never() -> WatchConfig {
 
 /// Tracks `seq` with `watch`; returns each frame's `lost` and mean fingertip error (px).
 fn track(seq: &Path, out: &Path, watch: WatchConfig) -> (Vec<bool>, Vec<f64>) {
+    track_with(seq, out, watch, TrackerConfig::default())
+}
+
+/// [`track`] with the tracker's parameters.
+fn track_with(
+    seq: &Path,
+    out: &Path,
+    watch: WatchConfig,
+    config: TrackerConfig,
+) -> (Vec<bool>, Vec<f64>) {
     let options = TrackOptions {
         watch,
         ..TrackOptions::default()
     };
-    track_sequence_opts(seq, out, TrackerConfig::default(), false, None, &options).unwrap();
+    track_sequence_opts(seq, out, config, false, None, &options).unwrap();
     let report = evaluate(seq, out).unwrap();
     let states = read_states(out, 28).unwrap();
     let lost = states
@@ -51,10 +61,12 @@ fn a_right_track_of_another_renderer_is_never_flagged() {
 
 #[test]
 fn a_track_the_image_no_longer_supports_is_flagged() {
-    // Seed 76 (a stereo rig of the robustness sweep, 640x480): from frame ~59 the track
-    // settles on wrong fingers while the tracker's own flag stays down. At 640x480 a check
-    // falls due every 32 frames, so the watch removes a third or more of those frames
-    // (measured: 30 -> 17), not all.
+    // Seed 76 (a stereo rig of the robustness sweep, 640x480), tracked without the palm's
+    // outline edges: from frame ~59 the track settles on wrong fingers while the tracker's
+    // own flag stays down. At 640x480 a check falls due every 32 frames, so the watch removes
+    // a third or more of those frames (measured: 30 -> 17), not all. (With the palm edges,
+    // the default, this seed is tracked right to frame 90 and no sweep seed offers a wrong
+    // track the watch catches: docs/robustness.md.)
     let dir = tempfile::tempdir().unwrap();
     let seq = dir.path().join("seq");
     let options = RenderOptions {
@@ -65,8 +77,12 @@ fn a_track_the_image_no_longer_supports_is_flagged() {
     };
     render_scenario("random-stereo", &seq, &options).unwrap();
     let wrong = 20.0; // px at 640 wide: the sweep's "truly lost"
-    let (watched, tips) = track(&seq, &dir.path().join("a.csv"), WatchConfig::default());
-    let (plain, plain_tips) = track(&seq, &dir.path().join("b.csv"), never());
+    let mut config = TrackerConfig::default();
+    config.features.palm_edges = false;
+    let a = dir.path().join("a.csv");
+    let (watched, tips) = track_with(&seq, &a, WatchConfig::default(), config.clone());
+    let b = dir.path().join("b.csv");
+    let (plain, plain_tips) = track_with(&seq, &b, never(), config);
     let claimed_wrong = |lost: &[bool], tips: &[f64]| {
         lost.iter()
             .zip(tips)

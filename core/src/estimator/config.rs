@@ -86,6 +86,9 @@ pub struct EstimatorConfig {
     pub conditioning: Conditioning,
     /// Weight of a tip row relative to an edge row.
     pub tip_weight: f32,
+    /// Weight of a palm outline edge row relative to a link's edge row
+    /// ([`add_palm_edge_rows`](super::add_palm_edge_rows)).
+    pub palm_edge_weight: f32,
 }
 
 impl Default for EstimatorConfig {
@@ -99,6 +102,7 @@ impl Default for EstimatorConfig {
                 joint: 1000.0,
             },
             tip_weight: 1.0,
+            palm_edge_weight: 1.0,
         }
     }
 }

@@ -204,6 +204,19 @@ pub fn add_link_rows(
     config: &EstimatorConfig,
     free: FreeMask,
 ) -> LinkRows {
+    add_weighted_link_rows(ne, link, features, jac, config, free, 1.0)
+}
+
+/// [`add_link_rows`] with every row's weight multiplied by `weight`.
+pub(crate) fn add_weighted_link_rows(
+    ne: &mut NormalEquations,
+    link: &ProjectedLink,
+    features: &LinkFeatures,
+    jac: &LinkJacobian,
+    config: &EstimatorConfig,
+    free: FreeMask,
+    weight: f32,
+) -> LinkRows {
     let mut added = LinkRows::default();
     if jac.states.is_empty() {
         return added;
@@ -214,7 +227,7 @@ pub fn add_link_rows(
             let basis = EdgeBasis::new(link);
             for e in &features.edges {
                 let (c, r) = basis.row(link, e);
-                block.add(&c, r, config.robust.weight(r));
+                block.add(&c, r, weight * config.robust.weight(r));
                 added.edges += 1;
             }
         }
@@ -243,7 +256,7 @@ pub fn add_link_rows(
                         basis.row(link, e)
                     }
                 };
-                block.add(&c, r, config.robust.weight(r));
+                block.add(&c, r, weight * config.robust.weight(r));
                 added.edges += 1;
             }
         }
@@ -254,7 +267,7 @@ pub fn add_link_rows(
                     let mut c = [0.0; PARAMS];
                     c[2 * end] = line_normal.x;
                     c[2 * end + 1] = line_normal.y;
-                    block.add(&c, line_normal.dot(&(point - centre)), 1.0);
+                    block.add(&c, line_normal.dot(&(point - centre)), weight);
                     added.edges += 1;
                 }
             }
@@ -265,7 +278,7 @@ pub fn add_link_rows(
         let (dir, _) = link.axis_frame();
         let r = dir.dot(&(link.b - tip)) + link.tip_offset;
         let c = [0.0, 0.0, dir.x, dir.y, 0.0, 1.0];
-        block.add(&c, r, config.tip_weight * config.robust.weight(r));
+        block.add(&c, r, weight * config.tip_weight * config.robust.weight(r));
         added.tips += 1;
     }
     block.scatter(ne, jac, free);

@@ -106,6 +106,19 @@ pub fn add_reference_rows(
     config: &EstimatorConfig,
     free: FreeMask,
 ) -> LinkRows {
+    add_weighted_reference_rows(ne, link, features, jac, config, free, 1.0)
+}
+
+/// [`add_reference_rows`] with every row's weight multiplied by `weight`.
+pub(crate) fn add_weighted_reference_rows(
+    ne: &mut NormalEquations,
+    link: &ProjectedLink,
+    features: &LinkFeatures,
+    jac: &LinkJacobian,
+    config: &EstimatorConfig,
+    free: FreeMask,
+    weight: f32,
+) -> LinkRows {
     let mut added = LinkRows::default();
     if jac.states.is_empty() {
         return added;
@@ -115,7 +128,7 @@ pub fn add_reference_rows(
         ResidualKind::EdgePoints => {
             for e in &features.edges {
                 let r = edge_row(link, jac, e, &mut row);
-                ne.add_row(&row, r, config.robust.weight(r), free);
+                ne.add_row(&row, r, weight * config.robust.weight(r), free);
                 added.edges += 1;
             }
         }
@@ -144,7 +157,7 @@ pub fn add_reference_rows(
                         edge_row(link, jac, e, &mut row)
                     }
                 };
-                ne.add_row(&row, r, config.robust.weight(r), free);
+                ne.add_row(&row, r, weight * config.robust.weight(r), free);
                 added.edges += 1;
             }
         }
@@ -152,7 +165,7 @@ pub fn add_reference_rows(
             if let Some(line) = fit_axis_line(link, features) {
                 for end in [0, 1] {
                     let r = line_row(link, jac, line, end, &mut row);
-                    ne.add_row(&row, r, 1.0, free);
+                    ne.add_row(&row, r, weight, free);
                     added.edges += 1;
                 }
             }
@@ -160,7 +173,12 @@ pub fn add_reference_rows(
     }
     if let Some(tip) = features.tip {
         let r = tip_row(link, jac, &tip, &mut row);
-        ne.add_row(&row, r, config.tip_weight * config.robust.weight(r), free);
+        ne.add_row(
+            &row,
+            r,
+            weight * config.tip_weight * config.robust.weight(r),
+            free,
+        );
         added.tips += 1;
     }
     added

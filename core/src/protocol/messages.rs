@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::params::{CameraParams, TrackerParams};
 use crate::acquire::AcquireConfig;
-use crate::config::{MAX_HYPOTHESES, MAX_LINKS, MAX_STATES};
+use crate::config::{MAX_HYPOTHESES, MAX_LINKS, MAX_SLICES_PER_LINK, MAX_STATES};
 use crate::features::MAX_LINK_EDGES;
 use crate::hypotheses::{HypothesesConfig, Hypothesis};
 use crate::status::Status;
@@ -47,6 +47,9 @@ pub enum BoardMessage {
     /// The hypotheses the board carries after a frame, best first: sent right after the
     /// frame's [`State`] whenever [`Configure::hypotheses`] is more than 1 (version 5).
     Hypotheses(Hypotheses),
+    /// What the slices across one edge of the palm's image outline found, in answer to
+    /// [`HostMessage::Measure`] when the tracker parameters ask for palm edges (version 6).
+    PalmEdges(PalmEdges),
 }
 
 /// Host → board.
@@ -68,8 +71,9 @@ pub enum HostMessage<'a> {
     /// `Ack(Hold)`, or `Nak(Hold, NotConfigured)` before a `Configure` (version 3).
     Hold,
     /// Search the held frame at a state and send what was found: a
-    /// [`BoardMessage::LinkEdges`] per link with anything to say, then
-    /// [`BoardMessage::Measured`] (version 3).
+    /// [`BoardMessage::LinkEdges`] per link with anything to say, a
+    /// [`BoardMessage::PalmEdges`] per palm outline edge with anything to say (version 6),
+    /// then [`BoardMessage::Measured`] (version 3).
     Measure(Measure),
 }
 
@@ -473,6 +477,27 @@ pub struct LinkEdges {
     pub masked: u16,
 }
 
+/// What the slices across one edge of the palm box's image outline found (the features the
+/// in-process tracker uses for it), in answer to a [`Measure`] (version 6). The edge is named
+/// by the two box corners it joins (`palm_outline::HullEdge::corners`): the host computes the
+/// same outline at the same state and looks the edge up by them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PalmEdges {
+    /// The frame searched.
+    pub frame: u32,
+    /// The [`Measure::iteration`] answered.
+    pub iteration: u8,
+    /// The box corners the outline edge joins, in outline order (each 0–7).
+    pub corners: [u8; 2],
+    /// The edge points found, in search order (`s` along the edge from `corners[0]`, `side`
+    /// the edge's outward side).
+    pub edges: Vec<WireEdge, MAX_SLICES_PER_LINK>,
+    /// Slices the model predicted visible and in the frame.
+    pub expected: u16,
+    /// Slices masked: hidden by a nearer link, or with a link just outside the edge.
+    pub masked: u16,
+}
+
 /// The end of an answer to a [`Measure`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -483,7 +508,7 @@ pub struct Measured {
     pub iteration: u8,
     /// Whether the board holds that frame; `false`: nothing was searched.
     pub held: bool,
-    /// [`LinkEdges`] messages sent for this measure.
+    /// [`LinkEdges`] and [`PalmEdges`] messages sent for this measure.
     pub links: u8,
     /// The silhouette agreement at the measured state (0..=1), when the tracker parameters
     /// ask for it (`silhouette_grid` > 0) and it can be scored.

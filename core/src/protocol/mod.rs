@@ -33,7 +33,10 @@ pub use params::{BadParameter, CameraParams, TrackerParams, WireResidual, WireRo
 /// Version 5: several hypotheses: `Configure` gained `hypotheses` (the count K), and the board
 /// sends `Hypotheses` (board message 10) after every `State` when K > 1 (docs/protocol.md
 /// §11).
-pub const PROTOCOL_VERSION: u8 = 5;
+/// Version 6: the palm's outline edges (issue 9): `TrackerParams` gained `palm_edges`, and a
+/// board answering `Measure` sends `PalmEdges` (board message 11) per palm outline edge with
+/// anything to say, counted in `Measured::links` (docs/protocol.md §12).
+pub const PROTOCOL_VERSION: u8 = 6;
 
 /// Largest `FrameChunk` payload (bytes).
 pub const MAX_CHUNK: usize = 1024;

@@ -114,6 +114,9 @@ pub struct TrackerParams {
     pub lost_min_found: f32,
     /// `lost` above this residual RMS (px, > 0).
     pub lost_rms_px: f32,
+    /// Slice across the palm box's own image outline too (version 6;
+    /// `FeatureConfig::palm_edges`).
+    pub palm_edges: bool,
 }
 
 /// A tracker parameter out of range.
@@ -154,6 +157,7 @@ impl TrackerParams {
             ],
             lost_min_found: config.lost_min_found,
             lost_rms_px: config.lost_rms_px,
+            palm_edges: config.features.palm_edges,
         }
     }
 
@@ -189,6 +193,7 @@ impl TrackerParams {
         features.slices_per_link = self.slices_per_link;
         features.window_px = self.window_px;
         features.min_contrast = self.min_contrast;
+        features.palm_edges = self.palm_edges;
         let mut estimator = defaults.estimator;
         estimator.residual = match self.residual {
             WireResidual::EdgePoints => ResidualKind::EdgePoints,

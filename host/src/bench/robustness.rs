@@ -37,6 +37,9 @@ pub enum Motion {
     /// The loop as the thesis ran it: no prior, the full velocity, a lost frame's estimate
     /// kept, no silhouette check.
     Plain,
+    /// The tracker's defaults without the palm's outline edges (`FeatureConfig::palm_edges`
+    /// off; issue 9).
+    NoPalmEdges,
 }
 
 impl Motion {
@@ -47,6 +50,9 @@ impl Motion {
             config.motion = MotionConfig::PLAIN;
             config.silhouette_grid = 0;
             config.lost_silhouette_drop = 0.0;
+        }
+        if self == Motion::NoPalmEdges {
+            config.features.palm_edges = false;
         }
         config
     }

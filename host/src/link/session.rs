@@ -279,7 +279,9 @@ impl Session {
             // They follow their frame's State, so they arrive while the next frame (or the
             // final ping) is awaited.
             BoardMessage::Hypotheses(h) => self.report.count_hypotheses(&h),
-            BoardMessage::LinkEdges(_) | BoardMessage::Measured(_) => self.report.late_answers += 1,
+            BoardMessage::LinkEdges(_) | BoardMessage::PalmEdges(_) | BoardMessage::Measured(_) => {
+                self.report.late_answers += 1
+            }
             BoardMessage::Hello(hello) => {
                 self.check_hello(&hello)?;
                 self.hello = hello;
