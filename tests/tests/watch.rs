@@ -80,7 +80,7 @@ fn a_track_the_image_no_longer_supports_is_flagged() {
     let mut config = TrackerConfig::default();
     config.features.palm_edges = false;
     let a = dir.path().join("a.csv");
-    let (watched, tips) = track_with(&seq, &a, WatchConfig::default(), config.clone());
+    let (watched, tips) = track_with(&seq, &a, WatchConfig::default(), config);
     let b = dir.path().join("b.csv");
     let (plain, plain_tips) = track_with(&seq, &b, never(), config);
     let claimed_wrong = |lost: &[bool], tips: &[f64]| {
