@@ -546,41 +546,45 @@ impl Tracker {
                     self.free,
                 );
             }
-            if !config.features.palm_edges {
-                continue;
-            }
-            work.outline
-                .update(view.palm.as_ref(), config.features.min_link_px);
-            for edge in &work.outline.edges {
-                measurer.palm_edge_features(
-                    camera_index,
-                    camera,
-                    view,
-                    edge,
-                    &config.features,
-                    refine,
-                    &mut work.features,
-                );
-                let found = work.features.edges.len() as u16;
-                report.features_found += found;
-                report.features_expected += work.features.expected;
-                report.features_masked += work.features.masked;
-                if found == 0 {
-                    continue;
+        }
+        // The lost test weighs the fingers' fit alone: the palm's rows below count neither
+        // towards the found share nor the residual. A palm the image does not show as the
+        // model's bright box (a sleeve, a glove, a renderer's other palm) must not make every
+        // frame lost, and on the sweep counting them bought nothing (lost recall 0.19 with
+        // them, 0.18 without; docs/robustness.md).
+        report.rms_px = work.normal.rms();
+        if config.features.palm_edges {
+            for (camera_index, (camera, view)) in
+                self.cameras.iter().zip(work.views.iter()).enumerate()
+            {
+                work.outline
+                    .update(view.palm.as_ref(), config.features.min_link_px);
+                for edge in &work.outline.edges {
+                    measurer.palm_edge_features(
+                        camera_index,
+                        camera,
+                        view,
+                        edge,
+                        &config.features,
+                        refine,
+                        &mut work.features,
+                    );
+                    if work.features.edges.is_empty() {
+                        continue;
+                    }
+                    work.jacobian
+                        .compute(&self.model, &work.poses, camera, &edge.segment);
+                    add_palm_edge_rows(
+                        &mut work.normal,
+                        edge,
+                        &work.features,
+                        &work.jacobian,
+                        &config.estimator,
+                        self.free,
+                    );
                 }
-                work.jacobian
-                    .compute(&self.model, &work.poses, camera, &edge.segment);
-                add_palm_edge_rows(
-                    &mut work.normal,
-                    edge,
-                    &work.features,
-                    &work.jacobian,
-                    &config.estimator,
-                    self.free,
-                );
             }
         }
-        report.rms_px = work.normal.rms();
         if work.normal.rows() == 0 {
             return None;
         }

@@ -124,9 +124,17 @@ fn uploaded_frames_give_the_in_process_trackers_states() {
             )
         );
         assert!(state.track_ticks > 0);
+        // A board reset from a given state tracks (it never searches here): `Tracking`, or
+        // `Lost` on a frame the tracker flags (the palm's outline, which these capsule-only
+        // frames do not draw, turns the last frames' palm a little: lost by the silhouette).
+        let tracked = if report.lost {
+            WireStatus::Lost
+        } else {
+            WireStatus::Tracking
+        };
         assert_eq!(
             (state.status, state.search_evaluations),
-            (WireStatus::Tracking, 0),
+            (tracked, 0),
             "a board reset from a given state tracks"
         );
         assert!(
