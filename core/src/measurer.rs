@@ -81,6 +81,13 @@ impl<'f, 'a> LocalFrames<'f, 'a> {
     }
 }
 
+impl<'a> LocalFrames<'_, 'a> {
+    /// Camera `index`'s frame and its search, when there is such a camera.
+    fn camera(&mut self, index: usize) -> Option<(&FrameView<'a>, &mut CameraSearch)> {
+        Some((self.frames.get(index)?, self.searches.get_mut(index)?))
+    }
+}
+
 impl Measurer for LocalFrames<'_, '_> {
     fn begin_iteration(&mut self, _q: &[f32], refine: bool) {
         if !refine {
@@ -100,14 +107,12 @@ impl Measurer for LocalFrames<'_, '_> {
         refine: bool,
         out: &mut LinkFeatures,
     ) {
-        let (Some(frame), Some(search)) = (
-            self.frames.get(camera_index),
-            self.searches.get_mut(camera_index),
-        ) else {
-            *out = LinkFeatures::default();
-            return;
-        };
-        search.link(view, camera, frame, index, config, refine, out);
+        match self.camera(camera_index) {
+            Some((frame, search)) => {
+                search.link(view, camera, frame, index, config, refine, out);
+            }
+            None => *out = LinkFeatures::default(),
+        }
     }
 
     fn palm_edge_features(
@@ -120,14 +125,12 @@ impl Measurer for LocalFrames<'_, '_> {
         refine: bool,
         out: &mut LinkFeatures,
     ) {
-        let (Some(frame), Some(search)) = (
-            self.frames.get(camera_index),
-            self.searches.get_mut(camera_index),
-        ) else {
-            *out = LinkFeatures::default();
-            return;
-        };
-        search.palm_edge(view, camera, frame, edge, config, refine, out);
+        match self.camera(camera_index) {
+            Some((frame, search)) => {
+                search.palm_edge(view, camera, frame, edge, config, refine, out);
+            }
+            None => *out = LinkFeatures::default(),
+        }
     }
 
     fn silhouette(

@@ -22,6 +22,34 @@ use crate::protocol::{BoardMessage, LinkEdges, Measure, Measured, PalmEdges, Wir
 use crate::search::CameraSearch;
 use crate::tracker::TrackerConfig;
 
+/// The wire form of edge points (their strength stays on the board); beyond `N` they are
+/// dropped, never a panic (a link's and an outline edge's searches yield at most `N`).
+fn wire_edges<const N: usize>(edges: &[EdgePoint]) -> heapless::Vec<WireEdge, N> {
+    let mut out = heapless::Vec::new();
+    for e in edges {
+        let _ = out.push(WireEdge {
+            s: e.s,
+            side: e.side,
+            position: [e.position.x, e.position.y],
+        });
+    }
+    out
+}
+
+/// Edge points from their wire form into `out.edges` (strength 0: no estimate uses it).
+fn edges_from_wire(edges: &[WireEdge], out: &mut LinkFeatures) {
+    out.edges.clear();
+    for e in edges {
+        // No more than a link's search yields: `out` holds that many.
+        let _ = out.edges.push(EdgePoint {
+            s: e.s,
+            side: e.side,
+            position: Vector2::new(e.position[0], e.position[1]),
+            strength: 0.0,
+        });
+    }
+}
+
 impl LinkEdges {
     /// The wire form of `features`: link `index` in view (model frame `link`), found in
     /// answer to `measure`.
@@ -31,15 +59,7 @@ impl LinkEdges {
             iteration: measure.iteration,
             index,
             link,
-            edges: features
-                .edges
-                .iter()
-                .map(|e| WireEdge {
-                    s: e.s,
-                    side: e.side,
-                    position: [e.position.x, e.position.y],
-                })
-                .collect(),
+            edges: wire_edges(&features.edges),
             tip: features.tip.map(|t| [t.x, t.y]),
             expected: features.expected,
             masked: features.masked,
@@ -49,16 +69,7 @@ impl LinkEdges {
     /// The features as the tracker uses them (edges, tip and the counts; the strength, the
     /// off-frame count and the reach stay on the board).
     pub fn to_features(&self, out: &mut LinkFeatures) {
-        out.edges.clear();
-        for e in &self.edges {
-            // Same capacity on both sides: cannot overflow.
-            let _ = out.edges.push(EdgePoint {
-                s: e.s,
-                side: e.side,
-                position: Vector2::new(e.position[0], e.position[1]),
-                strength: 0.0,
-            });
-        }
+        edges_from_wire(&self.edges, out);
         out.tip = self.tip.map(|t| Vector2::new(t[0], t[1]));
         out.expected = self.expected;
         out.masked = self.masked;
@@ -80,15 +91,7 @@ impl PalmEdges {
             frame: measure.frame,
             iteration: measure.iteration,
             corners: edge.corners,
-            edges: features
-                .edges
-                .iter()
-                .map(|e| WireEdge {
-                    s: e.s,
-                    side: e.side,
-                    position: [e.position.x, e.position.y],
-                })
-                .collect(),
+            edges: wire_edges(&features.edges),
             expected: features.expected,
             masked: features.masked,
         }
@@ -96,16 +99,7 @@ impl PalmEdges {
 
     /// The features as the tracker uses them (edges and the counts).
     pub fn to_features(&self, out: &mut LinkFeatures) {
-        out.edges.clear();
-        for e in &self.edges {
-            // At most `MAX_SLICES_PER_LINK` here, `2 · MAX_SLICES_PER_LINK` there.
-            let _ = out.edges.push(EdgePoint {
-                s: e.s,
-                side: e.side,
-                position: Vector2::new(e.position[0], e.position[1]),
-                strength: 0.0,
-            });
-        }
+        edges_from_wire(&self.edges, out);
         out.tip = None;
         out.expected = self.expected;
         out.masked = self.masked;
