@@ -301,7 +301,9 @@ const RIGHT_RAD: f32 = 0.2;
 #[test]
 fn an_end_on_bend_is_read_right_once_seen_with_several_hypotheses() {
     // Ten noise seeds: the outcome of one run depends on the noise, so the test judges the
-    // distribution. Measured: K=1 right on 0 of 10, K=4 on 4 of 10 (errors 0.06–0.18 rad).
+    // distribution. Measured: K=1 right on 0 of 10, K=4 on 4 of 10 (errors 0.06–0.18 rad);
+    // with the palm's outline edges, K=1 on 2 of 10 and K=4 on 5 (the palm held, the single
+    // track reads the bend right now and then), so K=4 must read it right on 3 more seeds.
     let seeds = 0..10u64;
     let (mut single, mut several) = (Vec::new(), Vec::new());
     for seed in seeds {
@@ -316,14 +318,10 @@ fn an_end_on_bend_is_read_right_once_seen_with_several_hypotheses() {
     let right = |v: &[f32]| v.iter().filter(|&&e| e <= RIGHT_RAD).count();
     let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len() as f32;
     assert!(
-        right(&single) <= 1,
-        "K=1 read the bend right {} times",
+        right(&several) >= right(&single) + 3,
+        "K=4 read the bend right {} times, K=1 {}",
+        right(&several),
         right(&single)
-    );
-    assert!(
-        right(&several) >= 3,
-        "K=4 read the bend right only {} times",
-        right(&several)
     );
     assert!(
         mean(&several) < 0.8 * mean(&single),
