@@ -1,0 +1,148 @@
+//! A/B of tracker settings on the sequences `bench robustness --keep DIR` kept: tracks every
+//! seed with each variant (comma-separated `key=value` overrides joined by `+`) and prints the
+//! track-life distribution per group. For trying a change quickly; the benchmark itself is
+//! the judge.
+//!
+//! ```text
+//! cargo run --release -p digiteyes-host --example kept_ab -- /tmp/keep default pj=500
+//! ```
+
+use anyhow::{bail, Result};
+use clap::Parser;
+use digiteyes_host::eval::{evaluate, stats};
+use digiteyes_host::track::{track_sequence_opts, TrackOptions};
+use digiteyes_host::TrackerConfig;
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+#[derive(Parser)]
+struct Args {
+    dir: PathBuf,
+    /// Variants: `default`, or overrides such as `pj=500+mask=1+iters=12`.
+    variants: Vec<String>,
+    /// Only seeds whose number has this parity (1 mono, 0 stereo).
+    #[arg(long)]
+    parity: Option<u64>,
+    #[arg(long, default_value_t = 2)]
+    jobs: usize,
+}
+
+fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
+    let mut c = TrackerConfig::default();
+    let mut o = TrackOptions::default();
+    if text == "default" {
+        return Ok((c, o));
+    }
+    for part in text.split('+') {
+        let Some((k, v)) = part.split_once('=') else {
+            bail!("bad override {part}")
+        };
+        let f: f32 = v.parse()?;
+        match k {
+            "pj" => c.motion.prior.joint = f,
+            "pt" => c.motion.prior.translation = f,
+            "pq" => c.motion.prior.quaternion = f,
+            "iters" => c.iterations = f as u8,
+            "predict" => c.predict = f != 0.0,
+            "window" => c.features.window_px = f as u8,
+            "slices" => c.features.slices_per_link = f as u8,
+            "palm" => c.features.palm_edges = f != 0.0,
+            "fvf" => c.motion.full_velocity_found = f,
+            "palmw" => c.estimator.palm_edge_weight = f,
+            "sj" => c.estimator.conditioning.joint = f,
+            "st" => c.estimator.conditioning.translation = f,
+            "sq" => c.estimator.conditioning.quaternion = f,
+            "tipw" => c.estimator.tip_weight = f,
+            "s" => o.hypotheses.score_every_frames = f as u8,
+            "spawn" => o.hypotheses.spawn_per_frame = f as u8,
+            "k" => o.hypotheses.count = f as u8,
+            "watch" => o.watch.every_frames = f as u8,
+            _ => bail!("unknown key {k}"),
+        }
+    }
+    Ok((c, o))
+}
+
+fn main() -> Result<()> {
+    let args = Args::parse();
+    let mut seeds: Vec<(u64, PathBuf)> = std::fs::read_dir(&args.dir)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.join("sequence.json").exists())
+        .filter_map(|p| {
+            let n = p
+                .file_name()?
+                .to_str()?
+                .trim_start_matches("seed")
+                .parse()
+                .ok()?;
+            Some((n, p))
+        })
+        .filter(|(n, _)| args.parity.is_none_or(|p| n % 2 == p))
+        .collect();
+    seeds.sort();
+    println!("variant group seeds life50 life10 ge95 joint50 tip50 lives");
+    for name in &args.variants {
+        let (config, options) = variant(name)?;
+        let results = Mutex::new(Vec::new());
+        let next = Mutex::new(0usize);
+        std::thread::scope(|scope| {
+            for _ in 0..args.jobs {
+                scope.spawn(|| loop {
+                    let i = {
+                        let mut n = next.lock().unwrap();
+                        *n += 1;
+                        *n - 1
+                    };
+                    let Some((seed, dir)) = seeds.get(i) else {
+                        break;
+                    };
+                    let out = std::env::temp_dir()
+                        .join(format!("kept_ab_{}_{seed}.csv", std::process::id()));
+                    let r = track_sequence_opts(dir, &out, config, false, None, &options)
+                        .and_then(|_| evaluate(dir, &out));
+                    let _ = std::fs::remove_file(&out);
+                    match r {
+                        Ok(r) => {
+                            let tip = r.cameras.iter().map(|c| c.fingertip_mean_px).sum::<f64>()
+                                / r.cameras.len() as f64;
+                            results.lock().unwrap().push((
+                                *seed,
+                                r.track_life,
+                                r.joint_rms_deg,
+                                tip,
+                            ))
+                        }
+                        Err(e) => eprintln!("seed {seed}: {e:#}"),
+                    }
+                });
+            }
+        });
+        let mut results = results.into_inner().unwrap();
+        results.sort_by_key(|r| r.0);
+        for (group, parity) in [("mono", 1), ("stereo", 0)] {
+            let g: Vec<_> = results.iter().filter(|r| r.0 % 2 == parity).collect();
+            if g.is_empty() {
+                continue;
+            }
+            let life: Vec<f64> = g.iter().map(|r| r.1).collect();
+            let joint: Vec<f64> = g.iter().map(|r| r.2).collect();
+            let tip: Vec<f64> = g.iter().map(|r| r.3).collect();
+            let ge95 = life.iter().filter(|&&l| l >= 0.95).count() as f64 / life.len() as f64;
+            let lives: Vec<String> = g
+                .iter()
+                .map(|r| format!("{}:{:.0}", r.0, 100.0 * r.1))
+                .collect();
+            println!(
+                "{name} {group} {} {:.0}% {:.0}% {:.0}% {:.2} {:.2} {}",
+                g.len(),
+                100.0 * stats::percentile(&life, 0.5),
+                100.0 * stats::percentile(&life, 0.1),
+                100.0 * ge95,
+                stats::percentile(&joint, 0.5),
+                stats::percentile(&tip, 0.5),
+                lives.join(" ")
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,293 @@
+//! Where a track goes wrong, measured against the truth on the sequences that
+//! `bench robustness --keep DIR` kept (each `seedNNNN/` with the tracker's `states.csv`).
+//!
+//! Modes (`--start`):
+//! - `truth`: every sampled frame is tracked alone from its own true state (the bias of the
+//!   measurement: how far the image's features pull the truth);
+//! - `prev`: ... from the previous frame's true state, no motion (one frame's true motion);
+//! - `prev-velocity`: ... from the previous frame's true state moving as the truth moved;
+//! - `contract`: ... from the truth carrying the kept run's error of the frame before: does
+//!   one frame of tracking shrink an error the track has (errors before and after, per tip);
+//! - `sequential`: the whole sequence, from frame 1's truth, with `--oracle` states set to the
+//!   truth before every frame (e.g. the palm's `0,1,2,3,4,5,6`: is the palm what is lost?);
+//! - `census`: no tracking; per seed, the frame where the kept run's track life ends and each
+//!   fingertip's error there (which fingers are lost).
+//!
+//! Errors are mean fingertip reprojection errors (px) over the tips and cameras, as `eval`
+//! has them.
+//!
+//! ```text
+//! digiteyes bench robustness --seeds 60 --frames 200 --keep /tmp/keep
+//! cargo run --release -p digiteyes-host --example truth_bias -- /tmp/keep --start truth
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::Parser;
+use digiteyes_core::config::MAX_STATES;
+use digiteyes_core::frame::FrameView;
+use digiteyes_core::kinematics::Poses;
+use digiteyes_core::model::Shape;
+use digiteyes_core::motion::PriorWeights;
+use digiteyes_core::tracker::Tracker;
+use digiteyes_host::eval::{compare, stats, track_life, LOST_ERROR_PX};
+use digiteyes_host::sequence::{read_states, Sequence};
+use digiteyes_host::{sequence_tracker, TrackerConfig};
+
+#[derive(Parser)]
+struct Args {
+    /// A folder of kept seeds (`seedNNNN/`), as `bench robustness --keep` writes.
+    dir: PathBuf,
+    /// Where each tracked frame starts (see the module's documentation).
+    #[arg(long, default_value = "truth")]
+    start: String,
+    /// Track every this many frames (not with `sequential`).
+    #[arg(long, default_value_t = 10)]
+    every: usize,
+    /// Only seeds whose number has this parity (1: mono, 0: stereo).
+    #[arg(long)]
+    parity: Option<u64>,
+    /// With `sequential`: these states are set to the truth before every frame.
+    #[arg(long, value_delimiter = ',')]
+    oracle: Vec<usize>,
+    /// No prior toward the prediction: the images alone.
+    #[arg(long)]
+    no_prior: bool,
+}
+
+/// One seed's sequence, truth and kept run.
+struct Seed {
+    number: u64,
+    sequence: Sequence,
+    truth: Vec<Vec<f32>>,
+    kept: Vec<Vec<f32>>,
+}
+
+fn f32s(rows: &[Vec<f64>]) -> Vec<Vec<f32>> {
+    rows.iter()
+        .map(|r| r.iter().map(|&v| v as f32).collect())
+        .collect()
+}
+
+fn open(dir: &Path) -> Result<Option<Seed>> {
+    let Some(number) = dir
+        .file_name()
+        .and_then(|n| n.to_str())
+        .and_then(|n| n.strip_prefix("seed"))
+        .and_then(|n| n.parse().ok())
+    else {
+        return Ok(None);
+    };
+    let sequence = Sequence::open(dir)?;
+    let truth = f32s(&sequence.read_truth()?.rows);
+    let kept = f32s(&read_states(&dir.join("states.csv"), sequence.n_states())?.rows);
+    Ok(Some(Seed {
+        number,
+        sequence,
+        truth,
+        kept,
+    }))
+}
+
+/// Each fingertip's reprojection error (px) in each camera, tips in model order.
+fn tip_errors(seed: &Seed, truth: &[f32], estimate: &[f32]) -> Result<Vec<f32>> {
+    let model = &seed.sequence.model;
+    let pt = Poses::compute(model, truth)?;
+    let pe = Poses::compute(model, estimate)?;
+    let mut out = Vec::new();
+    for camera in &seed.sequence.cameras {
+        for (i, link) in model.links().iter().enumerate() {
+            if !matches!(link.shape, Shape::Tip { .. }) {
+                continue;
+            }
+            let project = |p: &Poses| p.origin(i).and_then(|o| camera.project(&o));
+            out.push(match (project(&pt), project(&pe)) {
+                (Some(a), Some(b)) => (a - b).norm(),
+                _ => f32::INFINITY,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// The mean fingertip error (px) of `estimate` at frame `k`, as `eval` computes it.
+fn tip_error(seed: &Seed, k: usize, estimate: &[f32]) -> Result<f64> {
+    let seq = &seed.sequence;
+    let names: Vec<String> = (0..seq.cameras.len()).map(|c| seq.camera_name(c)).collect();
+    let to64 = |q: &[f32]| q.iter().map(|&v| f64::from(v)).collect::<Vec<f64>>();
+    let report = compare(
+        &seq.model,
+        &seq.cameras,
+        &names,
+        &seq.free_states(),
+        &[to64(&seed.truth[k])],
+        &[to64(estimate)],
+    )?;
+    Ok(report.fingertip_mean_by_frame[0])
+}
+
+fn track_frame(tracker: &mut Tracker, seed: &Seed, k: usize) -> Result<()> {
+    let seq = &seed.sequence;
+    let images = (0..seq.cameras.len())
+        .map(|c| seq.read_frame(c, k))
+        .collect::<Result<Vec<_>>>()?;
+    let frames = images
+        .iter()
+        .map(|img| FrameView::packed(img.as_raw(), img.width() as usize, img.height() as usize))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| anyhow::anyhow!("frame {k}: {e}"))?;
+    tracker.track(&frames).context("track")?;
+    Ok(())
+}
+
+fn start_at(
+    tracker: &mut Tracker,
+    state: &[f32],
+    velocity: Option<[f32; MAX_STATES]>,
+) -> Result<()> {
+    let mut memory = tracker.memory();
+    memory.state = heapless::Vec::from_slice(state).map_err(|_| anyhow::anyhow!("states"))?;
+    memory.velocity = velocity;
+    tracker.restore(&memory)?;
+    Ok(())
+}
+
+fn fmt_tips(tips: &[f32]) -> String {
+    tips.iter()
+        .map(|e| format!("{e:.1}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+fn main() -> Result<()> {
+    let args = Args::parse();
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(&args.dir)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.join("sequence.json").exists())
+        .collect();
+    dirs.sort();
+    let mut all = Vec::new();
+    let mut shrink = Vec::new();
+    for dir in dirs {
+        let Some(seed) = open(&dir)? else { continue };
+        if args.parity.is_some_and(|p| seed.number % 2 != p) {
+            continue;
+        }
+        let cams = seed.sequence.cameras.len();
+        if args.start == "census" {
+            let errors: Vec<f64> = (0..seed.truth.len())
+                .map(|k| tip_error(&seed, k, &seed.kept[k]))
+                .collect::<Result<_>>()?;
+            let life = track_life(&errors);
+            let end = (life * errors.len() as f64).round() as usize;
+            if end < errors.len() {
+                let tips = tip_errors(&seed, &seed.truth[end], &seed.kept[end])?;
+                let wrong = tips.iter().filter(|&&e| e > LOST_ERROR_PX as f32).count();
+                println!(
+                    "seed {} cams {cams} life {life:.2} ends at frame {end}: tips over {LOST_ERROR_PX} px {wrong} of {}: {}",
+                    seed.number,
+                    tips.len(),
+                    fmt_tips(&tips)
+                );
+                all.push(wrong as f64);
+            }
+            continue;
+        }
+        let mut config = TrackerConfig::default();
+        if args.no_prior {
+            config.motion.prior = PriorWeights::OFF;
+        }
+        let mut tracker = sequence_tracker(&seed.sequence, config)?;
+        let sequential = args.start == "sequential";
+        let step = if sequential { 1 } else { args.every.max(1) };
+        if sequential {
+            start_at(&mut tracker, &seed.truth[1], None)?;
+        }
+        let mut errors = Vec::new();
+        for k in (2..seed.truth.len()).step_by(step) {
+            let (t0, t1) = (&seed.truth[k - 1], &seed.truth[k]);
+            match args.start.as_str() {
+                "sequential" => {
+                    let mut q = tracker.state().to_vec();
+                    for &i in &args.oracle {
+                        if let (Some(v), Some(t)) = (q.get_mut(i), t0.get(i)) {
+                            *v = *t;
+                        }
+                    }
+                    let memory = tracker.memory();
+                    start_at(&mut tracker, &q, memory.velocity)?;
+                }
+                "truth" => start_at(&mut tracker, t1, None)?,
+                "prev" => start_at(&mut tracker, t0, None)?,
+                "prev-velocity" => {
+                    let mut velocity = [0.0f32; MAX_STATES];
+                    for (v, (a, b)) in velocity.iter_mut().zip(seed.truth[k - 2].iter().zip(t0)) {
+                        *v = b - a;
+                    }
+                    start_at(&mut tracker, t0, Some(velocity))?;
+                }
+                "contract" => {
+                    let start: Vec<f32> = (0..t1.len())
+                        .map(|i| t1[i] + seed.kept[k - 1][i] - t0[i])
+                        .collect();
+                    let before = tip_error(&seed, k, &start)?;
+                    start_at(&mut tracker, &start, None)?;
+                    track_frame(&mut tracker, &seed, k)?;
+                    let after = tip_error(&seed, k, tracker.state())?;
+                    errors.push(after);
+                    if before > 2.0 && before < 30.0 {
+                        shrink.push(after / before);
+                        println!(
+                            "  seed {} frame {k}: before {before:.1} after {after:.1}; tips after {}",
+                            seed.number,
+                            fmt_tips(&tip_errors(&seed, t1, tracker.state())?)
+                        );
+                    }
+                    continue;
+                }
+                other => anyhow::bail!("unknown --start {other}"),
+            }
+            track_frame(&mut tracker, &seed, k)?;
+            errors.push(tip_error(&seed, k, tracker.state())?);
+        }
+        let over = errors.iter().filter(|&&e| e > LOST_ERROR_PX).count() as f64;
+        println!(
+            "seed {} cams {cams} median {:.1} p90 {:.1} max {:.1} over {LOST_ERROR_PX} px {:.2} life {:.2}",
+            seed.number,
+            stats::percentile(&errors, 0.5),
+            stats::percentile(&errors, 0.9),
+            stats::percentile(&errors, 1.0),
+            over / errors.len().max(1) as f64,
+            track_life(&errors)
+        );
+        all.extend(errors);
+    }
+    if args.start == "census" {
+        println!(
+            "seeds whose life ended: {}; tips over {LOST_ERROR_PX} px there: median {:.0}",
+            all.len(),
+            stats::percentile(&all, 0.5)
+        );
+        return Ok(());
+    }
+    let over = all.iter().filter(|&&e| e > LOST_ERROR_PX).count() as f64;
+    println!(
+        "all: {} frames, median {:.2} px, p75 {:.2}, p90 {:.2}, over {LOST_ERROR_PX} px {:.3}",
+        all.len(),
+        stats::percentile(&all, 0.5),
+        stats::percentile(&all, 0.75),
+        stats::percentile(&all, 0.9),
+        over / all.len().max(1) as f64
+    );
+    if !shrink.is_empty() {
+        println!(
+            "contraction (after / before, errors of 2-30 px): median {:.2}, p10 {:.2}, p90 {:.2} over {} frames",
+            stats::percentile(&shrink, 0.5),
+            stats::percentile(&shrink, 0.1),
+            stats::percentile(&shrink, 0.9),
+            shrink.len()
+        );
+    }
+    Ok(())
+}
