@@ -1,7 +1,9 @@
 //! A/B of tracker settings on the sequences `bench robustness --keep DIR` kept: tracks every
-//! seed with each variant (comma-separated `key=value` overrides joined by `+`) and prints the
-//! track-life distribution per group. For trying a change quickly; the benchmark itself is
-//! the judge.
+//! seed with each variant and prints the track-life distribution per group. A variant is
+//! `default` or `key=value` overrides joined by `+` (keys: `pj`, `pt`, `pq` the prior's
+//! weights; `sj`, `st`, `sq` the conditioning; `iters`, `predict`, `window`, `slices`,
+//! `palm`, `palmw`, `tipw`, `fvf`; `k`, `s`, `spawn` the hypotheses; `watch` its period).
+//! For trying a change quickly; the benchmark itself is the judge.
 //!
 //! ```text
 //! cargo run --release -p digiteyes-host --example kept_ab -- /tmp/keep default pj=500
