@@ -31,7 +31,7 @@ use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Shape;
 use digiteyes_core::motion::PriorWeights;
 use digiteyes_core::tracker::Tracker;
-use digiteyes_host::eval::{compare, stats, track_life, LOST_ERROR_PX};
+use digiteyes_host::eval::{compare, reprojection_error, stats, track_life, LOST_ERROR_PX};
 use digiteyes_host::sequence::{read_states, Sequence};
 use digiteyes_host::{sequence_tracker, TrackerConfig};
 
@@ -90,25 +90,24 @@ fn open(dir: &Path) -> Result<Option<Seed>> {
     }))
 }
 
-/// Each fingertip's reprojection error (px) in each camera, tips in model order.
+/// Each fingertip's reprojection error (px) in each camera, tips in model order, as `eval`
+/// measures it.
 fn tip_errors(seed: &Seed, truth: &[f32], estimate: &[f32]) -> Result<Vec<f32>> {
     let model = &seed.sequence.model;
     let pt = Poses::compute(model, truth)?;
     let pe = Poses::compute(model, estimate)?;
-    let mut out = Vec::new();
-    for camera in &seed.sequence.cameras {
-        for (i, link) in model.links().iter().enumerate() {
-            if !matches!(link.shape, Shape::Tip { .. }) {
-                continue;
-            }
-            let project = |p: &Poses| p.origin(i).and_then(|o| camera.project(&o));
-            out.push(match (project(&pt), project(&pe)) {
-                (Some(a), Some(b)) => (a - b).norm(),
-                _ => f32::INFINITY,
-            });
-        }
-    }
-    Ok(out)
+    let tips: Vec<usize> = (0..model.links().len())
+        .filter(|&i| matches!(model.links()[i].shape, Shape::Tip { .. }))
+        .collect();
+    Ok(seed
+        .sequence
+        .cameras
+        .iter()
+        .flat_map(|camera| {
+            tips.iter()
+                .map(|&i| reprojection_error(camera, &pt, &pe, i) as f32)
+        })
+        .collect())
 }
 
 /// The mean fingertip error (px) of `estimate` at frame `k`, as `eval` computes it.

@@ -302,7 +302,7 @@ pub fn track_life_at(errors: &[f64], lost_error_px: f64) -> f64 {
 
 /// Image distance (px) between frame `i`'s origin at the true and at the estimated state.
 /// A point that does not project (at or behind the camera) counts as the image diagonal.
-fn reprojection_error(cam: &Camera, truth: &Poses, estimate: &Poses, i: usize) -> f64 {
+pub fn reprojection_error(cam: &Camera, truth: &Poses, estimate: &Poses, i: usize) -> f64 {
     let project = |p: &Poses| p.origin(i).and_then(|o| cam.project(&o));
     match (project(truth), project(estimate)) {
         (Some(a), Some(b)) => f64::from((a - b).norm()),
