@@ -51,6 +51,12 @@ struct Args {
     /// With `sequential`: these states are set to the truth before every frame.
     #[arg(long, value_delimiter = ',')]
     oracle: Vec<usize>,
+    /// With `settle`: how far each of one finger's joints is pushed off the truth (rad).
+    #[arg(long, default_value_t = 0.15)]
+    push_rad: f32,
+    /// With `settle`: how many times the frame is tracked.
+    #[arg(long, default_value_t = 10)]
+    passes: usize,
     /// No prior toward the prediction: the images alone.
     #[arg(long)]
     no_prior: bool,
@@ -168,6 +174,7 @@ fn main() -> Result<()> {
     dirs.sort();
     let mut all = Vec::new();
     let mut shrink = Vec::new();
+    let mut all_passes = Vec::new();
     for dir in dirs {
         let Some(seed) = open(&dir)? else { continue };
         if args.parity.is_some_and(|p| seed.number % 2 != p) {
@@ -226,6 +233,48 @@ fn main() -> Result<()> {
                     }
                     start_at(&mut tracker, t0, Some(velocity))?;
                 }
+                "settle" => {
+                    // The truth with one finger's joints pushed off, the same frame tracked
+                    // again and again from where the last pass left it.
+                    let fingers =
+                        digiteyes_core::hypotheses::fingers::Fingers::of(&seed.sequence.model);
+                    let f = (k / step) % fingers.count();
+                    let mut start = t1.to_vec();
+                    for (s, v) in start.iter_mut().enumerate() {
+                        if fingers.contains(f, s) {
+                            let sign = if (s + k) % 2 == 0 { 1.0 } else { -1.0 };
+                            *v = digiteyes_core::state::clamp_to_limit(
+                                &seed.sequence.model,
+                                s,
+                                *v + sign * args.push_rad,
+                            );
+                        }
+                    }
+                    let before = tip_error(&seed, k, &start)?;
+                    let mut trace = vec![before];
+                    let mut q = start;
+                    for _ in 0..args.passes {
+                        start_at(&mut tracker, &q, None)?;
+                        track_frame(&mut tracker, &seed, k)?;
+                        q = tracker.state().to_vec();
+                        trace.push(tip_error(&seed, k, &q)?);
+                    }
+                    println!(
+                        "  seed {} frame {k} finger {f}: {}",
+                        seed.number,
+                        trace
+                            .iter()
+                            .map(|e| format!("{e:.1}"))
+                            .collect::<Vec<_>>()
+                            .join(" ")
+                    );
+                    if before > 1.0 {
+                        shrink.push(trace[1] / before);
+                        all_passes.push(trace[trace.len() - 1] / before);
+                    }
+                    errors.push(trace[trace.len() - 1]);
+                    continue;
+                }
                 "contract" => {
                     let start: Vec<f32> = (0..t1.len())
                         .map(|i| t1[i] + seed.kept[k - 1][i] - t0[i])
@@ -279,6 +328,14 @@ fn main() -> Result<()> {
         stats::percentile(&all, 0.9),
         over / all.len().max(1) as f64
     );
+    if !all_passes.is_empty() {
+        println!(
+            "after all passes / before: median {:.2}, p10 {:.2}, p90 {:.2}",
+            stats::percentile(&all_passes, 0.5),
+            stats::percentile(&all_passes, 0.1),
+            stats::percentile(&all_passes, 0.9),
+        );
+    }
     if !shrink.is_empty() {
         println!(
             "contraction (after / before, errors of 2-30 px): median {:.2}, p10 {:.2}, p90 {:.2} over {} frames",

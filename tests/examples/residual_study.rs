@@ -17,9 +17,15 @@ fn main() -> anyhow::Result<()> {
         "fast",
         "clutter",
     ];
-    let variants: [(&str, ResidualKind, Robust, Conditioning); 8] = [
+    let variants: [(&str, ResidualKind, Robust, Conditioning); 9] = [
         (
-            "axis points + Huber 2 px (default)",
+            "axis points + Tukey 5 px (default)",
+            ResidualKind::AxisPoints,
+            Robust::Tukey(5.0),
+            TrackerConfig::default().estimator.conditioning,
+        ),
+        (
+            "axis points + Huber 2 px (the default before)",
             ResidualKind::AxisPoints,
             Robust::Huber(2.0),
             TrackerConfig::default().estimator.conditioning,
@@ -31,7 +37,7 @@ fn main() -> anyhow::Result<()> {
             TrackerConfig::default().estimator.conditioning,
         ),
         (
-            "edge points + Huber 2 px (default)",
+            "edge points + Huber 2 px",
             ResidualKind::EdgePoints,
             Robust::Huber(2.0),
             TrackerConfig::default().estimator.conditioning,
