@@ -11,10 +11,12 @@
 
 use std::path::PathBuf;
 
+#[path = "common/kept.rs"]
+mod kept;
+
 use anyhow::Result;
 use clap::Parser;
 use digiteyes_core::features::{FeatureConfig, LinkFeatures};
-use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::measurer::{LocalFrames, Measurer};
 use digiteyes_core::projection::ProjectedModel;
@@ -32,11 +34,7 @@ struct Args {
 
 fn main() -> Result<()> {
     let args = Args::parse();
-    let mut dirs: Vec<PathBuf> = std::fs::read_dir(&args.dir)?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.join("sequence.json").exists())
-        .collect();
-    dirs.sort();
+    let dirs = kept::seed_dirs(&args.dir)?;
     let config = FeatureConfig::default();
     // [depth in finger 0..3] -> residuals; 4 = palm-attached/other.
     let mut edge: Vec<Vec<f64>> = vec![Vec::new(); 5];
@@ -49,16 +47,8 @@ fn main() -> Result<()> {
         for k in (0..truth.len()).step_by(args.every.max(1)) {
             let q: Vec<f32> = truth[k].iter().map(|&v| v as f32).collect();
             let poses = Poses::compute(model, &q)?;
-            let images = (0..seq.cameras.len())
-                .map(|c| seq.read_frame(c, k))
-                .collect::<Result<Vec<_>>>()?;
-            let frames = images
-                .iter()
-                .map(|img| {
-                    FrameView::packed(img.as_raw(), img.width() as usize, img.height() as usize)
-                })
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| anyhow::anyhow!("{e}"))?;
+            let images = kept::read_instant(&seq, k)?;
+            let frames = kept::views(&images)?;
             let mut measurer = LocalFrames::new(&frames);
             measurer.begin_iteration(&q, false);
             for (ci, camera) in seq.cameras.iter().enumerate() {

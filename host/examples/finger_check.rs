@@ -21,6 +21,9 @@
 
 use std::path::{Path, PathBuf};
 
+#[path = "common/kept.rs"]
+mod kept;
+
 use anyhow::Result;
 use clap::Parser;
 use digiteyes_core::camera::Camera;
@@ -279,11 +282,7 @@ fn open(dir: &Path) -> Result<Kept> {
 
 fn main() -> Result<()> {
     let args = Args::parse();
-    let mut dirs: Vec<PathBuf> = std::fs::read_dir(&args.dir)?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.join("sequence.json").exists())
-        .collect();
-    dirs.sort();
+    let dirs = kept::seed_dirs(&args.dir)?;
     let config = LikelihoodConfig::default();
     let (mut bright_right, mut bright_wrong) = (Vec::new(), Vec::new());
     let (mut chamfer_right, mut chamfer_wrong) = (Vec::new(), Vec::new());
@@ -300,16 +299,8 @@ fn main() -> Result<()> {
             .filter_map(|i| finger_of_frame(model, &fingers, i).map(|f| (f, i)))
             .collect();
         for k in (1..truth.len().min(kept.len())).step_by(args.every.max(1)) {
-            let images = (0..seq.cameras.len())
-                .map(|c| seq.read_frame(c, k))
-                .collect::<Result<Vec<_>>>()?;
-            let frames = images
-                .iter()
-                .map(|img| {
-                    FrameView::packed(img.as_raw(), img.width() as usize, img.height() as usize)
-                })
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| anyhow::anyhow!("{e}"))?;
+            let images = kept::read_instant(&seq, k)?;
+            let frames = kept::views(&images)?;
             let mut buffers: Vec<Vec<u8>> = frames
                 .iter()
                 .map(|f| vec![0u8; EdgeMap::bytes_needed(f.width(), f.height(), config.stride_px)])

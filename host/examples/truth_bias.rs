@@ -10,6 +10,9 @@
 //!   one frame of tracking shrink an error the track has (errors before and after, per tip);
 //! - `sequential`: the whole sequence, from frame 1's truth, with `--oracle` states set to the
 //!   truth before every frame (e.g. the palm's `0,1,2,3,4,5,6`: is the palm what is lost?);
+//! - `settle`: the truth with one finger's joints pushed `--push-rad` off (0: the truth
+//!   itself), the same frame tracked `--passes` times, each from where the last left it:
+//!   where a static frame's iteration settles, and whether it pulls a finger back;
 //! - `census`: no tracking; per seed, the frame where the kept run's track life ends and each
 //!   fingertip's error there (which fingers are lost).
 //!
@@ -23,10 +26,12 @@
 
 use std::path::{Path, PathBuf};
 
+#[path = "common/kept.rs"]
+mod kept;
+
 use anyhow::{Context, Result};
 use clap::Parser;
 use digiteyes_core::config::MAX_STATES;
-use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Shape;
 use digiteyes_core::motion::PriorWeights;
@@ -134,14 +139,8 @@ fn tip_error(seed: &Seed, k: usize, estimate: &[f32]) -> Result<f64> {
 
 fn track_frame(tracker: &mut Tracker, seed: &Seed, k: usize) -> Result<()> {
     let seq = &seed.sequence;
-    let images = (0..seq.cameras.len())
-        .map(|c| seq.read_frame(c, k))
-        .collect::<Result<Vec<_>>>()?;
-    let frames = images
-        .iter()
-        .map(|img| FrameView::packed(img.as_raw(), img.width() as usize, img.height() as usize))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| anyhow::anyhow!("frame {k}: {e}"))?;
+    let images = kept::read_instant(seq, k)?;
+    let frames = kept::views(&images).with_context(|| format!("frame {k}"))?;
     tracker.track(&frames).context("track")?;
     Ok(())
 }
@@ -167,11 +166,7 @@ fn fmt_tips(tips: &[f32]) -> String {
 
 fn main() -> Result<()> {
     let args = Args::parse();
-    let mut dirs: Vec<PathBuf> = std::fs::read_dir(&args.dir)?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.join("sequence.json").exists())
-        .collect();
-    dirs.sort();
+    let dirs = kept::seed_dirs(&args.dir)?;
     let mut all = Vec::new();
     let mut shrink = Vec::new();
     let mut all_passes = Vec::new();
