@@ -19,13 +19,13 @@ fn main() -> anyhow::Result<()> {
     ];
     let variants: [(&str, ResidualKind, Robust, Conditioning); 9] = [
         (
-            "axis points + Tukey 5 px (default)",
+            "axis points + Tukey 5 px",
             ResidualKind::AxisPoints,
             Robust::Tukey(5.0),
             TrackerConfig::default().estimator.conditioning,
         ),
         (
-            "axis points + Huber 2 px (the default before)",
+            "axis points + Huber 2 px (default)",
             ResidualKind::AxisPoints,
             Robust::Huber(2.0),
             TrackerConfig::default().estimator.conditioning,

@@ -95,7 +95,7 @@ impl Default for EstimatorConfig {
     fn default() -> Self {
         EstimatorConfig {
             residual: ResidualKind::AxisPoints,
-            robust: Robust::Tukey(5.0),
+            robust: Robust::Huber(2.0),
             conditioning: Conditioning {
                 quaternion: 1.0,
                 translation: 1.0,
