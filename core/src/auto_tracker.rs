@@ -611,8 +611,9 @@ impl AutoTracker {
         Ok(())
     }
 
-    /// `start` refined by [`LOCAL_REFINE_PASSES`] fresh tracker passes on this frame, and its
-    /// mean and worst camera's likelihood score (0 when the tracker calls it lost).
+    /// `start` refined by [`LOCAL_REFINE_PASSES`] fresh tracker passes on this frame (under
+    /// the search's [`FinderConfig::leaf_robust`]), and its mean and worst camera's
+    /// likelihood score (0 when the tracker calls it lost).
     fn refine(
         &mut self,
         frames: &[FrameView<'_>],
@@ -622,10 +623,14 @@ impl AutoTracker {
     ) -> Result<Refined, AutoError> {
         let mut q = start;
         let mut report = FrameReport::default();
+        let leaf_robust = self.finder.config().leaf_robust;
         let tracker = self.multi.tracker_mut();
         for _ in 0..LOCAL_REFINE_PASSES {
             tracker.restart_fresh(&q[..n])?;
-            report = tracker.track(frames)?;
+            let own = tracker.swap_robust(leaf_robust);
+            let tracked = tracker.track(frames);
+            tracker.swap_robust(own);
+            report = tracked?;
             q[..n].copy_from_slice(&tracker.state()[..n]);
             if report.lost {
                 return Ok(Refined {

@@ -14,7 +14,7 @@ use crate::camera::{Camera, CameraError};
 use crate::config::{MAX_CAMERAS, MAX_STATES};
 use crate::estimator::{
     add_link_rows, add_palm_edge_rows, apply_step, EstimatorConfig, FreeMask, LinkJacobian,
-    NormalEquations,
+    NormalEquations, Robust,
 };
 use crate::features::{FeatureConfig, LinkFeatures};
 use crate::frame::{FrameError, FrameView};
@@ -247,6 +247,12 @@ impl Tracker {
         self.cameras = cameras;
         self.config = config;
         Ok(())
+    }
+
+    /// Sets the robust weight of the frames to come and returns the one it replaces (a
+    /// search refines its leaves under its own, [`FinderConfig::leaf_robust`](crate::acquire::FinderConfig::leaf_robust)).
+    pub fn swap_robust(&mut self, robust: Robust) -> Robust {
+        core::mem::replace(&mut self.config.estimator.robust, robust)
     }
 
     /// Restarts tracking from `state`, forgetting the motion so far.

@@ -172,6 +172,7 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         confirm_hypotheses: args.confirm_k.unwrap_or(f.confirm_hypotheses),
         alternative_score: args.alternative_score.unwrap_or(f.alternative_score),
         confirm_min_score: args.confirm_min_score.unwrap_or(f.confirm_min_score),
+        ..f
     };
     (acquire, finder)
 }

@@ -7,7 +7,7 @@
 use digiteyes_core::acquire::{AcquireConfig, Finder, FinderConfig, FinderStep, Progress};
 use digiteyes_core::auto_tracker::Status;
 use digiteyes_core::camera::Camera;
-use digiteyes_core::estimator::FreeMask;
+use digiteyes_core::estimator::{FreeMask, Robust};
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::EdgeMap;
@@ -111,6 +111,8 @@ fn hand_free_frames_are_never_claimed() {
             ..FinderConfig::default()
         };
         let (mut tracker, mut finder) = finder(&sequence, acquire, config);
+        // A tracker weighting its residuals otherwise than the search refines leaves.
+        tracker.swap_robust(Robust::Tukey(5.0));
         let mut bufs = search::buffers(&sequence.cameras, acquire.likelihood.stride_px);
         let (mut leaves, mut best) = (0u32, 0.0f32);
         for (k, (noise, clutter)) in [(0, false), (8, false), (8, true), (0, true)]
@@ -167,6 +169,12 @@ fn hand_free_frames_are_never_claimed() {
         assert!(
             leaves >= 20 * 8,
             "{rig}: the search must have reached its leaves on every frame: {leaves}"
+        );
+        // The leaves were refined under the search's robust weight; the tracker keeps its own.
+        assert_eq!(
+            tracker.config().estimator.robust,
+            Robust::Tukey(5.0),
+            "{rig}: refining leaves must leave the tracker's robust weight as it was"
         );
     }
 }
@@ -259,6 +267,52 @@ fn tip_error_px(model: &Model, cameras: &[Camera], a: &[f32], b: &[f32]) -> f32 
     sum / n as f32
 }
 
+/// `rig` at `seed` (34 frames, 320×240) searched from nothing by the status machine under
+/// `tracker`: per frame, whether a hand was claimed within 5 px of the truth, and the line
+/// `y` (claimed, right) / `n` (claimed, wrong) / `.` (none).
+fn acquisition(
+    dir: &std::path::Path,
+    rig: &str,
+    seed: u64,
+    tracker: TrackerConfig,
+) -> (Vec<bool>, String) {
+    let sequence = render(dir, rig, seed, 34);
+    let truth = sequence.read_truth().unwrap();
+    let (mut auto, mut bufs) = search::searching_with(&sequence, AcquireConfig::default(), tracker);
+    let (mut good, mut line) = (Vec::new(), String::new());
+    for k in 0..sequence.frames {
+        let images: Vec<_> = (0..sequence.cameras.len())
+            .map(|c| sequence.read_frame(c, k).unwrap())
+            .collect();
+        let views: Vec<FrameView<'_>> = images
+            .iter()
+            .map(|i| {
+                FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize).unwrap()
+            })
+            .collect();
+        let mut b: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
+        let r = auto.step(&views, &mut b).unwrap();
+        let claimed = r.status == Status::Tracking && !r.report.lost;
+        let t: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
+        let ok =
+            claimed && tip_error_px(&sequence.model, &sequence.cameras, auto.state(), &t) <= 5.0;
+        line.push(if ok {
+            'y'
+        } else if claimed {
+            'n'
+        } else {
+            '.'
+        });
+        good.push(ok);
+    }
+    (good, line)
+}
+
+/// The first frame before `before` from which the hand is held right for 5 frames.
+fn acquired_before(good: &[bool], before: usize) -> Option<usize> {
+    (0..before).find(|&k| good[k..k + 5].iter().all(|&g| g))
+}
+
 #[test]
 fn the_hand_is_acquired_from_nothing_on_rigs_the_sweep_acquires() {
     // Tuning seeds the probe acquires with the defaults (docs/recovery.md), through the
@@ -276,40 +330,30 @@ fn the_hand_is_acquired_from_nothing_on_rigs_the_sweep_acquires() {
         ("random-stereo", 104, 15),
         ("random-stereo", 139, 15),
     ] {
-        let sequence = render(dir.path(), rig, seed, 34);
-        let truth = sequence.read_truth().unwrap();
-        let (mut auto, mut bufs) = search::searching(&sequence, AcquireConfig::default());
-        let (mut good, mut line) = (Vec::new(), String::new());
-        for k in 0..sequence.frames {
-            let images: Vec<_> = (0..sequence.cameras.len())
-                .map(|c| sequence.read_frame(c, k).unwrap())
-                .collect();
-            let views: Vec<FrameView<'_>> = images
-                .iter()
-                .map(|i| {
-                    FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize).unwrap()
-                })
-                .collect();
-            let mut b: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
-            let r = auto.step(&views, &mut b).unwrap();
-            let claimed = r.status == Status::Tracking && !r.report.lost;
-            let t: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
-            let ok = claimed
-                && tip_error_px(&sequence.model, &sequence.cameras, auto.state(), &t) <= 5.0;
-            line.push(if ok {
-                'y'
-            } else if claimed {
-                'n'
-            } else {
-                '.'
-            });
-            good.push(ok);
-        }
+        let (good, line) = acquisition(dir.path(), rig, seed, TrackerConfig::default());
         println!("{rig} {seed}: {line}");
-        let acquired = (0..before).find(|&k| good[k..k + 5].iter().all(|&g| g));
         assert!(
-            acquired.is_some(),
+            acquired_before(&good, before).is_some(),
             "{rig} {seed} was not acquired before frame {before}: {line}"
         );
     }
+}
+
+#[test]
+fn leaves_are_refined_under_the_searchs_robust_weight_not_the_trackers() {
+    // Under Tukey's weight at 5 px an edge farther than 5 px from its prediction pulls
+    // nothing, and a search leaf starts farther than that: when the leaves were refined
+    // under the tracker's own weight, a tracker configured with it no longer acquired
+    // `random-mono` seed 133 (docs/robustness.md). Leaves are refined under
+    // `FinderConfig::leaf_robust` (Huber 2 px), so it still does.
+    let dir = tempfile::tempdir().unwrap();
+    let mut tukey = TrackerConfig::default();
+    tukey.estimator.robust = Robust::Tukey(5.0);
+    assert_ne!(FinderConfig::default().leaf_robust, tukey.estimator.robust);
+    let (good, line) = acquisition(dir.path(), "random-mono", 133, tukey);
+    println!("random-mono 133 under Tukey 5 px: {line}");
+    assert!(
+        acquired_before(&good, 30).is_some(),
+        "random-mono 133 was not acquired before frame 30 under Tukey: {line}"
+    );
 }

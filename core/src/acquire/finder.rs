@@ -8,6 +8,7 @@
 use heapless::Vec;
 
 use crate::config::{MAX_CAMERAS, MAX_STATES};
+use crate::estimator::Robust;
 use crate::frame::FrameView;
 use crate::likelihood::EdgeMap;
 use crate::tracker::{FrameReport, Tracker, TrackerError};
@@ -44,6 +45,9 @@ pub struct FinderConfig {
     /// The mean score over the confirming frames the best hypothesis needs for the hand to
     /// be kept; under it the hand is given up and searched for again (0: always kept).
     pub confirm_min_score: f32,
+    /// The robust weight of a leaf's refinement, in place of the tracker's own: a leaf starts
+    /// several px from the hand, where a weight that falls to zero (Tukey) pulls nothing.
+    pub leaf_robust: Robust,
 }
 
 impl Default for FinderConfig {
@@ -58,6 +62,7 @@ impl Default for FinderConfig {
             confirm_hypotheses: 4,
             alternative_score: 0.85,
             confirm_min_score: 0.0,
+            leaf_robust: Robust::Huber(2.0),
         }
     }
 }
@@ -251,8 +256,23 @@ impl Finder {
     }
 
     /// `leaf` refined by the tracker's Gauss–Newton ([`FinderConfig::passes_per_leaf`] fresh
-    /// passes on the frame), scored in every camera and judged.
+    /// passes on the frame, weighted by [`FinderConfig::leaf_robust`]), scored in every
+    /// camera and judged. The tracker keeps its own robust weight afterwards.
     fn refine(
+        &mut self,
+        tracker: &mut Tracker,
+        frames: &[FrameView<'_>],
+        edges: &[EdgeMap<'_>],
+        leaf: &[f32; MAX_STATES],
+        n: usize,
+    ) -> Result<(Verdict, [f32; MAX_STATES], FrameReport), TrackerError> {
+        let own = tracker.swap_robust(self.config.leaf_robust);
+        let refined = self.refine_with(tracker, frames, edges, leaf, n);
+        tracker.swap_robust(own);
+        refined
+    }
+
+    fn refine_with(
         &mut self,
         tracker: &mut Tracker,
         frames: &[FrameView<'_>],

@@ -33,12 +33,21 @@ pub fn acquirer(sequence: &Sequence, acquire: AcquireConfig) -> Acquirer {
 /// The status machine of `track --init auto` on `sequence`, searching from the first frame,
 /// with its edge-map buffers.
 pub fn searching(sequence: &Sequence, acquire: AcquireConfig) -> (AutoTracker, Vec<Vec<u8>>) {
+    searching_with(sequence, acquire, TrackerConfig::default())
+}
+
+/// [`searching`] with the tracker's parameters `tracker`.
+pub fn searching_with(
+    sequence: &Sequence,
+    acquire: AcquireConfig,
+    tracker: TrackerConfig,
+) -> (AutoTracker, Vec<Vec<u8>>) {
     let auto = AutoTracker::new(
         sequence.model.clone(),
         &sequence.cameras,
         &base(sequence.n_states()),
         sequence.free_mask(),
-        TrackerConfig::default(),
+        tracker,
         acquire,
     )
     .unwrap();
