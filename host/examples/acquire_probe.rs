@@ -33,6 +33,7 @@ use digiteyes_core::acquire::{
 use digiteyes_core::auto_tracker::{AutoTracker, Status};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::config::MAX_STATES;
+use digiteyes_core::estimator::Robust;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::EdgeMap;
@@ -103,6 +104,9 @@ struct Args {
     alternative_score: Option<f32>,
     #[arg(long)]
     min_camera_score: Option<f32>,
+    /// The robust weight leaves are refined under: `huber=K`, `tukey=C` (px) or `none`.
+    #[arg(long)]
+    leaf_robust: Option<String>,
     /// Write every refined leaf's judgement and true error here (CSV).
     #[arg(long)]
     leaves_csv: Option<std::path::PathBuf>,
@@ -172,9 +176,23 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         confirm_hypotheses: args.confirm_k.unwrap_or(f.confirm_hypotheses),
         alternative_score: args.alternative_score.unwrap_or(f.alternative_score),
         confirm_min_score: args.confirm_min_score.unwrap_or(f.confirm_min_score),
-        ..f
+        leaf_robust: args
+            .leaf_robust
+            .as_deref()
+            .map_or(f.leaf_robust, robust_weight),
     };
     (acquire, finder)
+}
+
+/// `huber=K`, `tukey=C` or `none`; anything else is the default leaves' weight.
+fn robust_weight(text: &str) -> Robust {
+    let value = |s: &str| s.parse::<f32>().ok().filter(|v| *v > 0.0);
+    match text.split_once('=') {
+        Some(("huber", k)) => value(k).map_or(FinderConfig::default().leaf_robust, Robust::Huber),
+        Some(("tukey", c)) => value(c).map_or(FinderConfig::default().leaf_robust, Robust::Tukey),
+        _ if text == "none" => Robust::None,
+        _ => FinderConfig::default().leaf_robust,
+    }
 }
 
 /// Mean fingertip distance (px) between states `a` and `b` over every camera.

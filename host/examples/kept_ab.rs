@@ -13,14 +13,16 @@
 //! cargo run --release -p digiteyes-host --example kept_ab -- /tmp/keep default pj=500
 //! ```
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::Parser;
-use digiteyes_core::estimator::Robust;
 use digiteyes_host::eval::{evaluate, stats};
-use digiteyes_host::track::{track_sequence_opts, TrackOptions};
-use digiteyes_host::TrackerConfig;
+use digiteyes_host::track::track_sequence_opts;
 use std::path::PathBuf;
 use std::sync::Mutex;
+
+#[path = "common/kept.rs"]
+mod kept;
+use kept::variant;
 
 #[derive(Parser)]
 struct Args {
@@ -35,44 +37,6 @@ struct Args {
     parity: Option<u64>,
     #[arg(long, default_value_t = 2)]
     jobs: usize,
-}
-
-fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
-    let mut c = TrackerConfig::default();
-    let mut o = TrackOptions::default();
-    if text == "default" {
-        return Ok((c, o));
-    }
-    for part in text.split('+') {
-        let Some((k, v)) = part.split_once('=') else {
-            bail!("bad override {part}")
-        };
-        let f: f32 = v.parse()?;
-        match k {
-            "pj" => c.motion.prior.joint = f,
-            "pt" => c.motion.prior.translation = f,
-            "pq" => c.motion.prior.quaternion = f,
-            "iters" => c.iterations = f as u8,
-            "predict" => c.predict = f != 0.0,
-            "window" => c.features.window_px = f as u8,
-            "slices" => c.features.slices_per_link = f as u8,
-            "palm" => c.features.palm_edges = f != 0.0,
-            "fvf" => c.motion.full_velocity_found = f,
-            "palmw" => c.estimator.palm_edge_weight = f,
-            "sj" => c.estimator.conditioning.joint = f,
-            "st" => c.estimator.conditioning.translation = f,
-            "sq" => c.estimator.conditioning.quaternion = f,
-            "tipw" => c.estimator.tip_weight = f,
-            "huber" => c.estimator.robust = Robust::Huber(f),
-            "tukey" => c.estimator.robust = Robust::Tukey(f),
-            "s" => o.hypotheses.score_every_frames = f as u8,
-            "spawn" => o.hypotheses.spawn_per_frame = f as u8,
-            "k" => o.hypotheses.count = f as u8,
-            "watch" => o.watch.every_frames = f as u8,
-            _ => bail!("unknown key {k}"),
-        }
-    }
-    Ok((c, o))
 }
 
 fn main() -> Result<()> {

@@ -38,7 +38,7 @@ use digiteyes_core::motion::PriorWeights;
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::eval::{compare, reprojection_error, stats, track_life, LOST_ERROR_PX};
 use digiteyes_host::sequence::{read_states, Sequence};
-use digiteyes_host::{sequence_tracker, TrackerConfig};
+use digiteyes_host::sequence_tracker;
 
 #[derive(Parser)]
 struct Args {
@@ -65,6 +65,10 @@ struct Args {
     /// No prior toward the prediction: the images alone.
     #[arg(long)]
     no_prior: bool,
+    /// The tracker's parameters: `default`, or overrides as `kept_ab` takes them
+    /// (`window=12+tipw=0`).
+    #[arg(long, default_value = "default")]
+    set: String,
 }
 
 /// One seed's sequence, truth and kept run.
@@ -195,7 +199,7 @@ fn main() -> Result<()> {
             }
             continue;
         }
-        let mut config = TrackerConfig::default();
+        let (mut config, _) = kept::variant(&args.set)?;
         if args.no_prior {
             config.motion.prior = PriorWeights::OFF;
         }

@@ -3,9 +3,12 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, bail, Result};
+use digiteyes_core::estimator::Robust;
 use digiteyes_core::frame::FrameView;
 use digiteyes_host::sequence::Sequence;
+use digiteyes_host::track::TrackOptions;
+use digiteyes_host::TrackerConfig;
 use image::GrayImage;
 
 /// The kept seeds' folders in `dir` (each with a `sequence.json`), in name order.
@@ -34,4 +37,44 @@ pub fn views(images: &[GrayImage]) -> Result<Vec<FrameView<'_>>> {
                 .map_err(|e| anyhow!("{e}"))
         })
         .collect()
+}
+
+/// A tracker's parameters and options: `default`, or overrides joined by `+` such as
+/// `pj=500+iters=12+tukey=5` (the keys are listed in the match below).
+pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
+    let mut c = TrackerConfig::default();
+    let mut o = TrackOptions::default();
+    if text == "default" {
+        return Ok((c, o));
+    }
+    for part in text.split('+') {
+        let Some((k, v)) = part.split_once('=') else {
+            bail!("bad override {part}")
+        };
+        let f: f32 = v.parse()?;
+        match k {
+            "pj" => c.motion.prior.joint = f,
+            "pt" => c.motion.prior.translation = f,
+            "pq" => c.motion.prior.quaternion = f,
+            "iters" => c.iterations = f as u8,
+            "predict" => c.predict = f != 0.0,
+            "window" => c.features.window_px = f as u8,
+            "slices" => c.features.slices_per_link = f as u8,
+            "palm" => c.features.palm_edges = f != 0.0,
+            "fvf" => c.motion.full_velocity_found = f,
+            "palmw" => c.estimator.palm_edge_weight = f,
+            "sj" => c.estimator.conditioning.joint = f,
+            "st" => c.estimator.conditioning.translation = f,
+            "sq" => c.estimator.conditioning.quaternion = f,
+            "tipw" => c.estimator.tip_weight = f,
+            "huber" => c.estimator.robust = Robust::Huber(f),
+            "tukey" => c.estimator.robust = Robust::Tukey(f),
+            "s" => o.hypotheses.score_every_frames = f as u8,
+            "spawn" => o.hypotheses.spawn_per_frame = f as u8,
+            "k" => o.hypotheses.count = f as u8,
+            "watch" => o.watch.every_frames = f as u8,
+            _ => bail!("unknown key {k}"),
+        }
+    }
+    Ok((c, o))
 }
