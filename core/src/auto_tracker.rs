@@ -627,10 +627,7 @@ impl AutoTracker {
         let tracker = self.multi.tracker_mut();
         for _ in 0..LOCAL_REFINE_PASSES {
             tracker.restart_fresh(&q[..n])?;
-            let own = tracker.swap_robust(leaf_robust);
-            let tracked = tracker.track(frames);
-            tracker.swap_robust(own);
-            report = tracked?;
+            report = tracker.track_under(leaf_robust, frames)?;
             q[..n].copy_from_slice(&tracker.state()[..n]);
             if report.lost {
                 return Ok(Refined {

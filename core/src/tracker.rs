@@ -249,10 +249,18 @@ impl Tracker {
         Ok(())
     }
 
-    /// Sets the robust weight of the frames to come and returns the one it replaces (a
-    /// search refines its leaves under its own, [`FinderConfig::leaf_robust`](crate::acquire::FinderConfig::leaf_robust)).
-    pub fn swap_robust(&mut self, robust: Robust) -> Robust {
-        core::mem::replace(&mut self.config.estimator.robust, robust)
+    /// [`Tracker::track`] with residuals weighted by `robust` instead of the configured
+    /// weight, which is back in place afterwards, error or not: a search refines its leaves
+    /// under its own ([`FinderConfig::leaf_robust`](crate::acquire::FinderConfig::leaf_robust)).
+    pub fn track_under(
+        &mut self,
+        robust: Robust,
+        frames: &[FrameView<'_>],
+    ) -> Result<FrameReport, TrackerError> {
+        let own = core::mem::replace(&mut self.config.estimator.robust, robust);
+        let report = self.track(frames);
+        self.config.estimator.robust = own;
+        report
     }
 
     /// Restarts tracking from `state`, forgetting the motion so far.

@@ -51,12 +51,6 @@ struct Args {
     single: bool,
 }
 
-fn f32s(rows: &[Vec<f64>]) -> Vec<Vec<f32>> {
-    rows.iter()
-        .map(|r| r.iter().map(|&v| v as f32).collect())
-        .collect()
-}
-
 /// The finger of each projected link (by its frame's last joint state), `None` for none.
 fn finger_of_frame(model: &Model, fingers: &Fingers, frame: usize) -> Option<usize> {
     let chain = model.chain(frame)?;
@@ -275,8 +269,8 @@ type Kept = (Sequence, Vec<Vec<f32>>, Vec<Vec<f32>>);
 
 fn open(dir: &Path) -> Result<Kept> {
     let sequence = Sequence::open(dir)?;
-    let truth = f32s(&sequence.read_truth()?.rows);
-    let kept = f32s(&read_states(&dir.join("states.csv"), sequence.n_states())?.rows);
+    let truth = kept::f32s(&sequence.read_truth()?.rows);
+    let kept = kept::f32s(&read_states(&dir.join("states.csv"), sequence.n_states())?.rows);
     Ok((sequence, truth, kept))
 }
 

@@ -44,13 +44,8 @@ fn frames(dir: &std::path::Path, states: &str) -> Result<Vec<Frame>> {
     let sequence = Sequence::open(dir)?;
     let model = &sequence.model;
     let n = sequence.n_states();
-    let f32s = |rows: &[Vec<f64>]| -> Vec<Vec<f32>> {
-        rows.iter()
-            .map(|r| r.iter().map(|&v| v as f32).collect())
-            .collect()
-    };
-    let truth = f32s(&sequence.read_truth()?.rows);
-    let tracked = f32s(&read_states(&dir.join(states), n)?.rows);
+    let truth = kept::f32s(&sequence.read_truth()?.rows);
+    let tracked = kept::f32s(&read_states(&dir.join(states), n)?.rows);
     let mut out = Vec::new();
     let mut view = ProjectedModel::default();
     for (t, e) in truth.iter().zip(&tracked) {

@@ -79,12 +79,6 @@ struct Seed {
     kept: Vec<Vec<f32>>,
 }
 
-fn f32s(rows: &[Vec<f64>]) -> Vec<Vec<f32>> {
-    rows.iter()
-        .map(|r| r.iter().map(|&v| v as f32).collect())
-        .collect()
-}
-
 fn open(dir: &Path) -> Result<Option<Seed>> {
     let Some(number) = dir
         .file_name()
@@ -95,8 +89,8 @@ fn open(dir: &Path) -> Result<Option<Seed>> {
         return Ok(None);
     };
     let sequence = Sequence::open(dir)?;
-    let truth = f32s(&sequence.read_truth()?.rows);
-    let kept = f32s(&read_states(&dir.join("states.csv"), sequence.n_states())?.rows);
+    let truth = kept::f32s(&sequence.read_truth()?.rows);
+    let kept = kept::f32s(&read_states(&dir.join("states.csv"), sequence.n_states())?.rows);
     Ok(Some(Seed {
         number,
         sequence,

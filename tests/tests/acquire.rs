@@ -17,7 +17,7 @@ use digiteyes_host::sequence::Sequence;
 use digiteyes_host::{render_scenario, RenderOptions, TrackerConfig};
 
 mod common;
-use common::search;
+use common::{frames, search};
 
 /// A hand-free frame: the background's grey, optional noise, optional clutter (bright and
 /// dark bars at every angle), from a small deterministic generator.
@@ -112,7 +112,9 @@ fn hand_free_frames_are_never_claimed() {
         };
         let (mut tracker, mut finder) = finder(&sequence, acquire, config);
         // A tracker weighting its residuals otherwise than the search refines leaves.
-        tracker.swap_robust(Robust::Tukey(5.0));
+        let mut tukey = TrackerConfig::default();
+        tukey.estimator.robust = Robust::Tukey(5.0);
+        tracker.reconfigure(&sequence.cameras, tukey).unwrap();
         let mut bufs = search::buffers(&sequence.cameras, acquire.likelihood.stride_px);
         let (mut leaves, mut best) = (0u32, 0.0f32);
         for (k, (noise, clutter)) in [(0, false), (8, false), (8, true), (0, true)]
@@ -184,15 +186,8 @@ fn the_search_keeps_its_budget_and_goes_on_where_it_left_off() {
     let dir = tempfile::tempdir().unwrap();
     for (rig, seed) in [("random-mono", 101), ("random-stereo", 102)] {
         let sequence = render(dir.path(), rig, seed, 1);
-        let frames: Vec<_> = (0..sequence.cameras.len())
-            .map(|c| sequence.read_frame(c, 0).unwrap())
-            .collect();
-        let views: Vec<FrameView<'_>> = frames
-            .iter()
-            .map(|i| {
-                FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize).unwrap()
-            })
-            .collect();
+        let images = frames::images(&sequence, 0);
+        let views = frames::views(&images);
         let config = AcquireConfig::default();
         let budget = config.evaluations_per_frame;
         let mut bufs = search::buffers(&sequence.cameras, config.likelihood.stride_px);
@@ -281,15 +276,8 @@ fn acquisition(
     let (mut auto, mut bufs) = search::searching_with(&sequence, AcquireConfig::default(), tracker);
     let (mut good, mut line) = (Vec::new(), String::new());
     for k in 0..sequence.frames {
-        let images: Vec<_> = (0..sequence.cameras.len())
-            .map(|c| sequence.read_frame(c, k).unwrap())
-            .collect();
-        let views: Vec<FrameView<'_>> = images
-            .iter()
-            .map(|i| {
-                FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize).unwrap()
-            })
-            .collect();
+        let images = frames::images(&sequence, k);
+        let views = frames::views(&images);
         let mut b: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
         let r = auto.step(&views, &mut b).unwrap();
         let claimed = r.status == Status::Tracking && !r.report.lost;

@@ -4,13 +4,13 @@
 //! refute given up; the local re-acquisition's variants of the last good state.
 
 mod common;
+use common::frames::{images, views};
 use common::search;
 
 use digiteyes_core::acquire::{AcquireConfig, FinderConfig, LOCAL_VARIANTS};
 use digiteyes_core::auto_tracker::Status;
 use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::FreeMask;
-use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::{HypothesesConfig, MultiTracker};
 use digiteyes_core::likelihood::EdgeMap;
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
@@ -27,19 +27,6 @@ fn render(dir: &std::path::Path, scenario: &str, seed: u64, frames: usize) -> Se
     };
     render_scenario(scenario, &seq, &options).unwrap();
     Sequence::open(&seq).unwrap()
-}
-
-fn images(sequence: &Sequence, k: usize) -> Vec<image::GrayImage> {
-    (0..sequence.cameras.len())
-        .map(|c| sequence.read_frame(c, k).unwrap())
-        .collect()
-}
-
-fn views(images: &[image::GrayImage]) -> Vec<FrameView<'_>> {
-    images
-        .iter()
-        .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize).unwrap())
-        .collect()
 }
 
 fn whole(q: &[f32]) -> [f32; MAX_STATES] {

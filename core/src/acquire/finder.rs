@@ -266,22 +266,9 @@ impl Finder {
         leaf: &[f32; MAX_STATES],
         n: usize,
     ) -> Result<(Verdict, [f32; MAX_STATES], FrameReport), TrackerError> {
-        let own = tracker.swap_robust(self.config.leaf_robust);
-        let refined = self.refine_with(tracker, frames, edges, leaf, n);
-        tracker.swap_robust(own);
-        refined
-    }
-
-    fn refine_with(
-        &mut self,
-        tracker: &mut Tracker,
-        frames: &[FrameView<'_>],
-        edges: &[EdgeMap<'_>],
-        leaf: &[f32; MAX_STATES],
-        n: usize,
-    ) -> Result<(Verdict, [f32; MAX_STATES], FrameReport), TrackerError> {
+        let robust = self.config.leaf_robust;
         tracker.restart_fresh(&leaf[..n])?;
-        let mut report = tracker.track(frames)?;
+        let mut report = tracker.track_under(robust, frames)?;
         for _ in 1..self.config.passes_per_leaf.max(1) {
             if report.lost {
                 break;
@@ -292,7 +279,7 @@ impl Finder {
                 *d = *s;
             }
             tracker.restart_fresh(&q[..n])?;
-            report = tracker.track(frames)?;
+            report = tracker.track_under(robust, frames)?;
         }
         let mut q = [0.0f32; MAX_STATES];
         for (d, s) in q.iter_mut().zip(tracker.state()) {

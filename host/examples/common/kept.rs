@@ -21,6 +21,13 @@ pub fn seed_dirs(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(dirs)
 }
 
+/// State rows as the tracker takes them (f32).
+pub fn f32s(rows: &[Vec<f64>]) -> Vec<Vec<f32>> {
+    rows.iter()
+        .map(|r| r.iter().map(|&v| v as f32).collect())
+        .collect()
+}
+
 /// Every camera's frame `k` of `sequence`.
 pub fn read_instant(sequence: &Sequence, k: usize) -> Result<Vec<GrayImage>> {
     (0..sequence.cameras.len())

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod browser;
+pub mod frames;
 pub mod search;
 
 use std::path::{Path, PathBuf};
