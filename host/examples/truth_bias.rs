@@ -9,7 +9,8 @@
 //! - `contract`: ... from the truth carrying the kept run's error of the frame before: does
 //!   one frame of tracking shrink an error the track has (errors before and after, per tip);
 //! - `sequential`: the whole sequence, from frame 1's truth, with `--oracle` states set to the
-//!   truth before every frame (e.g. the palm's `0,1,2,3,4,5,6`: is the palm what is lost?);
+//!   truth before every frame (e.g. the palm's `0,1,2,3,4,5,6`: is the palm what is lost?),
+//!   and with `--oracle-unseen N` every joint no camera sees (is what it cannot see lost?);
 //! - `settle`: the truth with one finger's joints pushed `--push-rad` off (0: the truth
 //!   itself), the same frame tracked `--passes` times, each from where the last left it:
 //!   where a static frame's iteration settles, and whether it pulls a finger back;
@@ -28,12 +29,14 @@ use std::path::{Path, PathBuf};
 
 #[path = "common/kept.rs"]
 mod kept;
+#[path = "common/seen.rs"]
+mod seen;
 
 use anyhow::{Context, Result};
 use clap::Parser;
 use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::model::Shape;
+use digiteyes_core::model::{Shape, BASE_STATES};
 use digiteyes_core::motion::PriorWeights;
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::eval::{compare, reprojection_error, stats, track_life, LOST_ERROR_PX};
@@ -56,6 +59,11 @@ struct Args {
     /// With `sequential`: these states are set to the truth before every frame.
     #[arg(long, value_delimiter = ',')]
     oracle: Vec<usize>,
+    /// With `sequential`: also every joint that moves no link a camera sees at the frame's
+    /// truth (`seen_bound`'s test, at least this many axis points) is set to that truth
+    /// before the frame: the tracker is left only what the images can tell it.
+    #[arg(long)]
+    oracle_unseen: Option<usize>,
     /// With `settle`: how far each of one finger's joints is pushed off the truth (rad).
     #[arg(long, default_value_t = 0.15)]
     push_rad: f32,
@@ -212,6 +220,15 @@ fn main() -> Result<()> {
                     for &i in &args.oracle {
                         if let (Some(v), Some(t)) = (q.get_mut(i), t0.get(i)) {
                             *v = *t;
+                        }
+                    }
+                    if let Some(points) = args.oracle_unseen {
+                        let poses = Poses::compute(&seed.sequence.model, t1)?;
+                        let seen = seen::joints(&seed.sequence, &poses, points);
+                        for (i, v) in q.iter_mut().enumerate() {
+                            if i >= BASE_STATES && !seen[i] {
+                                *v = t1[i];
+                            }
                         }
                     }
                     let memory = tracker.memory();

@@ -1,0 +1,168 @@
+//! How long could *any* tracker hold the sweep's hands, if it knew exactly what the cameras
+//! see and nothing more? On the sequences `bench robustness --keep DIR` kept (only their
+//! truth and cameras are read), a *seen-oracle* is built frame by frame: the palm's 7 states
+//! are the truth, and so is every joint that moves a link some camera sees at the truth (a
+//! point of the link's axis inside the frame and not hidden by a nearer part of the hand, by
+//! the core's own depth-order test, `visibility::cover`); a joint that moves no seen link
+//! keeps what the oracle had (`hold`), or goes on at the speed it last had while seen
+//! (`velocity`, clamped to the joint's range). Its track life is then computed as `eval` and
+//! the benchmark compute it, over every fingertip in every camera.
+//!
+//! This is a generous ceiling for an image-based tracker: it is perfect wherever the image
+//! has anything to say, and the palm is always right. A target above it cannot be met on the
+//! sweep by any tracker that only follows what it sees.
+//!
+//! ```text
+//! digiteyes bench robustness --seeds 60 --frames 200 --keep /tmp/keep
+//! cargo run --release -p digiteyes-host --example seen_bound -- /tmp/keep [--points 1]
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+use clap::Parser;
+use digiteyes_core::kinematics::Poses;
+use digiteyes_core::model::BASE_STATES;
+use digiteyes_core::projection::ProjectedModel;
+use digiteyes_host::eval::stats::percentile;
+use digiteyes_host::eval::{reprojection_error, track_life};
+use digiteyes_host::sequence::Sequence;
+
+#[path = "common/kept.rs"]
+mod kept;
+#[path = "common/seen.rs"]
+mod seen;
+
+#[derive(Parser)]
+struct Args {
+    /// Folders of kept seeds (`seedNNNN/`), as `bench robustness --keep` writes.
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    /// Points along a link's axis that must be seen for the link to count as seen.
+    #[arg(long, default_value_t = 1)]
+    points: usize,
+}
+
+/// A joint's guess while it is not seen.
+#[derive(Clone, Copy)]
+enum Unseen {
+    Hold,
+    Velocity,
+}
+
+/// The seen-oracle's states over `truth`, and the share of joint-frames not seen.
+fn oracle(
+    sequence: &Sequence,
+    truth: &[Vec<f32>],
+    points: usize,
+    how: Unseen,
+) -> Result<(Vec<Vec<f32>>, f64)> {
+    let model = &sequence.model;
+    let n = model.n_states();
+    let mut out: Vec<Vec<f32>> = Vec::with_capacity(truth.len());
+    let mut speed = vec![0.0f32; n];
+    let (mut unseen, mut total) = (0usize, 0usize);
+    for (k, t) in truth.iter().enumerate() {
+        let poses = Poses::compute(model, t)?;
+        let seen = seen::joints(sequence, &poses, points);
+        let mut state = t.clone();
+        if let Some(last) = out.last() {
+            for j in BASE_STATES..n {
+                total += 1;
+                if seen[j] {
+                    speed[j] = t[j] - truth[k - 1][j];
+                    continue;
+                }
+                unseen += 1;
+                let step = match how {
+                    Unseen::Hold => 0.0,
+                    Unseen::Velocity => speed[j],
+                };
+                let mut v = last[j] + step;
+                if let Some(l) = model.limit(j) {
+                    v = v.clamp(l.lo, l.hi);
+                }
+                state[j] = v;
+            }
+        }
+        out.push(state);
+    }
+    Ok((out, unseen as f64 / total.max(1) as f64))
+}
+
+/// Mean fingertip error over every tip and camera, per frame (px).
+fn tip_errors(sequence: &Sequence, truth: &[Vec<f32>], states: &[Vec<f32>]) -> Result<Vec<f64>> {
+    let model = &sequence.model;
+    let mut out = Vec::with_capacity(truth.len());
+    let mut view = ProjectedModel::default();
+    for (t, e) in truth.iter().zip(states) {
+        let (pt, pe) = (Poses::compute(model, t)?, Poses::compute(model, e)?);
+        let mut errors = Vec::new();
+        for camera in &sequence.cameras {
+            view.update(model, &pt, camera, 0.0);
+            for link in view.links.iter().filter(|l| l.distal) {
+                errors.push(reprojection_error(
+                    camera,
+                    &pt,
+                    &pe,
+                    usize::from(link.child),
+                ));
+            }
+        }
+        out.push(errors.iter().sum::<f64>() / errors.len().max(1) as f64);
+    }
+    Ok(out)
+}
+
+fn seed_of(dir: &Path) -> u64 {
+    dir.file_name()
+        .and_then(|n| n.to_str())
+        .and_then(|n| n.trim_start_matches("seed").parse().ok())
+        .unwrap_or(0)
+}
+
+fn main() -> Result<()> {
+    let args = Args::parse();
+    let ways = [("hold", Unseen::Hold), ("velocity", Unseen::Velocity)];
+    // Per way and group (stereo 0, mono 1): lives; per group: unseen shares.
+    let mut life = vec![[Vec::new(), Vec::new()]; ways.len()];
+    let mut unseen = [Vec::new(), Vec::new()];
+    for base in &args.dirs {
+        for dir in kept::seed_dirs(base)? {
+            let seed = seed_of(&dir);
+            let g = (seed % 2) as usize;
+            let sequence = Sequence::open(&dir)?;
+            let truth = kept::f32s(&sequence.read_truth()?.rows);
+            let mut line = format!("seed {seed}:");
+            for (w, (name, how)) in ways.iter().enumerate() {
+                let (states, share) = oracle(&sequence, &truth, args.points, *how)?;
+                let l = track_life(&tip_errors(&sequence, &truth, &states)?);
+                life[w][g].push(l);
+                if w == 0 {
+                    unseen[g].push(share);
+                    line += &format!(" joints unseen {:.0} %;", 100.0 * share);
+                }
+                line += &format!(" life ({name}) {:.0} %", 100.0 * l);
+            }
+            println!("{line}");
+        }
+    }
+    for (g, group) in [(1, "mono"), (0, "stereo")] {
+        let n = unseen[g].len();
+        let mean_unseen = unseen[g].iter().sum::<f64>() / n.max(1) as f64;
+        println!(
+            "{group}: {n} seeds; joint-frames unseen {:.0} %",
+            100.0 * mean_unseen
+        );
+        for (w, (name, _)) in ways.iter().enumerate() {
+            let l = &life[w][g];
+            println!(
+                "  seen-oracle, unseen joints {name}: life median {:.0} %, p10 {:.0} %, >= 95 % on {} of {n}",
+                100.0 * percentile(l, 0.5),
+                100.0 * percentile(l, 0.1),
+                l.iter().filter(|&&v| v >= 0.95).count()
+            );
+        }
+    }
+    Ok(())
+}
