@@ -163,6 +163,14 @@ fn start_at(
     Ok(())
 }
 
+/// The angle between the palm rotations of two states (deg): quaternion states 0..4.
+fn palm_turn_deg(a: &[f32], b: &[f32]) -> f64 {
+    let dot: f64 = (0..4).map(|i| f64::from(a[i]) * f64::from(b[i])).sum();
+    let norm = |q: &[f32]| (0..4).map(|i| f64::from(q[i]).powi(2)).sum::<f64>().sqrt();
+    let c = (dot / (norm(a) * norm(b)).max(1e-12)).abs().min(1.0);
+    2.0 * c.acos().to_degrees()
+}
+
 fn fmt_tips(tips: &[f32]) -> String {
     tips.iter()
         .map(|e| format!("{e:.1}"))
@@ -176,6 +184,8 @@ fn main() -> Result<()> {
     let mut all = Vec::new();
     let mut shrink = Vec::new();
     let mut all_passes = Vec::new();
+    // Settle runs whose error grew over 3×: how far the palm turned (deg).
+    let mut grown_turns = Vec::new();
     for dir in dirs {
         let Some(seed) = open(&dir)? else { continue };
         if args.parity.is_some_and(|p| seed.number % 2 != p) {
@@ -269,8 +279,12 @@ fn main() -> Result<()> {
                         q = tracker.state().to_vec();
                         trace.push(tip_error(&seed, k, &q)?);
                     }
+                    let turned = palm_turn_deg(&q, t1);
+                    if before > 1.0 && trace[trace.len() - 1] > 3.0 * before {
+                        grown_turns.push(turned);
+                    }
                     println!(
-                        "  seed {} frame {k} finger {f}: {}",
+                        "  seed {} frame {k} finger {f}, palm turned {turned:.1} deg: {}",
                         seed.number,
                         trace
                             .iter()
@@ -344,6 +358,15 @@ fn main() -> Result<()> {
             stats::percentile(&all_passes, 0.5),
             stats::percentile(&all_passes, 0.1),
             stats::percentile(&all_passes, 0.9),
+        );
+    }
+    if !grown_turns.is_empty() {
+        println!(
+            "runs grown over 3x: {}; palm turned median {:.1} deg, p10 {:.1}, p90 {:.1}",
+            grown_turns.len(),
+            stats::percentile(&grown_turns, 0.5),
+            stats::percentile(&grown_turns, 0.1),
+            stats::percentile(&grown_turns, 0.9),
         );
     }
     if !shrink.is_empty() {
