@@ -8,9 +8,10 @@
 //! (`velocity`, clamped to the joint's range). Its track life is then computed as `eval` and
 //! the benchmark compute it, over every fingertip in every camera.
 //!
-//! This is a generous ceiling for an image-based tracker: it is perfect wherever the image
-//! has anything to say, and the palm is always right. A target above it cannot be met on the
-//! sweep by any tracker that only follows what it sees.
+//! This is a generous ceiling for an image-based tracker: it is perfect wherever the geometry
+//! leaves anything in view, and the palm is always right. A target above it is out of reach
+//! of a tracker that follows what it sees, unless it guesses the hidden joints better than
+//! by holding them.
 //!
 //! ```text
 //! digiteyes bench robustness --seeds 60 --frames 200 --keep /tmp/keep

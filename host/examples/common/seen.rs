@@ -29,7 +29,7 @@ pub fn joints(sequence: &Sequence, poses: &Poses, points: usize) -> Vec<bool> {
                 .filter(|&k| {
                     let s = (k as f32 + 0.5) / AXIS_POINTS as f32;
                     let p = link.a + (link.b - link.a) * s;
-                    let front = link.z0 + (link.z1 - link.z0) * s - link.radius_mm;
+                    let front = link.depth_at(s) - link.radius_mm;
                     inside(&p) && cover(&view, camera, i, &p, front) != Cover::Hidden
                 })
                 .count();
