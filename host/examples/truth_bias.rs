@@ -171,6 +171,20 @@ fn palm_turn_deg(a: &[f32], b: &[f32]) -> f64 {
     2.0 * c.acos().to_degrees()
 }
 
+/// Prints `label` with the median, 10th and 90th percentiles of `values` and `tail`; nothing
+/// when there are no values.
+fn print_spread(label: &str, values: &[f64], tail: &str) {
+    if values.is_empty() {
+        return;
+    }
+    println!(
+        "{label} median {:.2}, p10 {:.2}, p90 {:.2}{tail}",
+        stats::percentile(values, 0.5),
+        stats::percentile(values, 0.1),
+        stats::percentile(values, 0.9),
+    );
+}
+
 fn fmt_tips(tips: &[f32]) -> String {
     tips.iter()
         .map(|e| format!("{e:.1}"))
@@ -352,31 +366,19 @@ fn main() -> Result<()> {
         stats::percentile(&all, 0.9),
         over / all.len().max(1) as f64
     );
-    if !all_passes.is_empty() {
-        println!(
-            "after all passes / before: median {:.2}, p10 {:.2}, p90 {:.2}",
-            stats::percentile(&all_passes, 0.5),
-            stats::percentile(&all_passes, 0.1),
-            stats::percentile(&all_passes, 0.9),
-        );
-    }
-    if !grown_turns.is_empty() {
-        println!(
-            "runs grown over 3x: {}; palm turned median {:.1} deg, p10 {:.1}, p90 {:.1}",
-            grown_turns.len(),
-            stats::percentile(&grown_turns, 0.5),
-            stats::percentile(&grown_turns, 0.1),
-            stats::percentile(&grown_turns, 0.9),
-        );
-    }
-    if !shrink.is_empty() {
-        println!(
-            "contraction (after / before, errors of 2-30 px): median {:.2}, p10 {:.2}, p90 {:.2} over {} frames",
-            stats::percentile(&shrink, 0.5),
-            stats::percentile(&shrink, 0.1),
-            stats::percentile(&shrink, 0.9),
-            shrink.len()
-        );
-    }
+    print_spread("after all passes / before:", &all_passes, "");
+    print_spread(
+        &format!(
+            "runs grown over 3x: {}; palm turned (deg)",
+            grown_turns.len()
+        ),
+        &grown_turns,
+        "",
+    );
+    print_spread(
+        "contraction (after / before, errors of 2-30 px):",
+        &shrink,
+        &format!(" over {} frames", shrink.len()),
+    );
     Ok(())
 }
