@@ -612,7 +612,7 @@ impl AutoTracker {
     }
 
     /// `start` refined by [`LOCAL_REFINE_PASSES`] fresh tracker passes on this frame (under
-    /// the search's [`FinderConfig::leaf_robust`]), and its mean and worst camera's
+    /// the search's [`FinderConfig::leaf_robust`] and edge test), and its mean and worst camera's
     /// likelihood score (0 when the tracker calls it lost).
     fn refine(
         &mut self,
@@ -624,10 +624,11 @@ impl AutoTracker {
         let mut q = start;
         let mut report = FrameReport::default();
         let leaf_robust = self.finder.config().leaf_robust;
+        let leaf_angle = self.finder.config().leaf_max_edge_angle_rad;
         let tracker = self.multi.tracker_mut();
         for _ in 0..LOCAL_REFINE_PASSES {
             tracker.restart_fresh(&q[..n])?;
-            report = tracker.track_under(leaf_robust, frames)?;
+            report = tracker.track_under(leaf_robust, leaf_angle, frames)?;
             q[..n].copy_from_slice(&tracker.state()[..n]);
             if report.lost {
                 return Ok(Refined {

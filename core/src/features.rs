@@ -62,6 +62,13 @@ pub struct FeatureConfig {
     /// Also slice across the palm box's own image outline ([`find_palm_edge_features`]),
     /// so the palm's pose is seen by its edges and not only through the fingers'.
     pub palm_edges: bool,
+    /// An edge found on a slice is kept only if the image's own edge there runs within this
+    /// angle of the predicted one (rad): the gradient's component along the predicted edge is
+    /// at most `tan(angle)` of its component across it ([`edge_runs_along`]). A slice that
+    /// crosses another finger's or the palm's outline at an angle then finds nothing rather
+    /// than that outline. `π/2` or more keeps every edge. Default 30°, judged on the sweep
+    /// (`docs/robustness.md`).
+    pub max_edge_angle_rad: f32,
 }
 
 impl Default for FeatureConfig {
@@ -77,8 +84,43 @@ impl Default for FeatureConfig {
             mask_occluded: true,
             tips: true,
             palm_edges: true,
+            max_edge_angle_rad: 30.0 * core::f32::consts::PI / 180.0,
         }
     }
+}
+
+impl FeatureConfig {
+    /// `tan(max_edge_angle_rad)`, or `None` when every edge is kept.
+    pub fn edge_tangent_limit(&self) -> Option<f32> {
+        (self.max_edge_angle_rad < core::f32::consts::FRAC_PI_2 - 1e-3)
+            .then(|| libm::tanf(self.max_edge_angle_rad.max(0.0)))
+    }
+}
+
+/// Whether the image's edge at `p` runs along the predicted edge, whose outward normal is
+/// `outward` (a unit vector): the intensity gradient, by a 3×3 Sobel turned to the slice,
+/// has a component along the edge at most `limit` times its component across it. True where
+/// the stencil leaves the frame (nothing to judge).
+pub fn edge_runs_along(
+    frame: &FrameView<'_>,
+    p: Vector2<f32>,
+    outward: Vector2<f32>,
+    limit: f32,
+) -> bool {
+    let along = Vector2::new(-outward.y, outward.x);
+    let at = |a: f32, b: f32| frame.sample_vec(p + outward * a + along * b);
+    let mut across = 0.0f32;
+    let mut tangent = 0.0f32;
+    for (w, o) in [(1.0f32, -1.0f32), (2.0, 0.0), (1.0, 1.0)] {
+        let (Some(out_n), Some(in_n), Some(out_t), Some(in_t)) =
+            (at(1.0, o), at(-1.0, o), at(o, 1.0), at(o, -1.0))
+        else {
+            return true;
+        };
+        across += w * (out_n - in_n);
+        tangent += w * (out_t - in_t);
+    }
+    libm::fabsf(tangent) <= limit * libm::fabsf(across)
 }
 
 /// Fewest samples a search window has: the smoothed derivative needs 2 samples each side of a
@@ -323,6 +365,7 @@ fn search_link<W: FnMut(&SearchWindow)>(
     let (dir, normal) = link.axis_frame();
     let slices = usize::from(config.slices_per_link).clamp(1, MAX_SLICES_PER_LINK);
     let mut profile = [0.0f32; MAX_WINDOW];
+    let tangent_limit = config.edge_tangent_limit();
     let slice_s = |k: usize| {
         if slices == 1 {
             0.5 * (config.span[0] + config.span[1])
@@ -396,6 +439,11 @@ fn search_link<W: FnMut(&SearchWindow)>(
         } else {
             find_edge(&profile[..window], config.polarity, config.min_contrast)
         };
+        let edge = edge.filter(|e| {
+            tangent_limit.is_none_or(|limit| {
+                edge_runs_along(frame, start + outward * e.position, outward, limit)
+            })
+        });
         let Some(edge) = edge else {
             watched(WindowOutcome::NoEdge);
             return None;

@@ -146,6 +146,11 @@ impl<'a> FrameView<'a> {
         Some(top + (bottom - top) * fy)
     }
 
+    /// [`FrameView::sample`] at a point.
+    pub fn sample_vec(&self, p: Vector2<f32>) -> Option<f32> {
+        self.sample(p.x, p.y)
+    }
+
     /// Samples `out.len()` points `start + k · step`, k = 0, 1, ... Returns false, leaving
     /// `out` partly written, if any point falls outside the frame.
     pub fn sample_segment(&self, start: Vector2<f32>, step: Vector2<f32>, out: &mut [f32]) -> bool {

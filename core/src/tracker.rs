@@ -249,17 +249,25 @@ impl Tracker {
         Ok(())
     }
 
-    /// [`Tracker::track`] with residuals weighted by `robust` instead of the configured
-    /// weight, which is back in place afterwards, error or not: a search refines its leaves
-    /// under its own ([`FinderConfig::leaf_robust`](crate::acquire::FinderConfig::leaf_robust)).
+    /// [`Tracker::track`] with residuals weighted by `robust` and edges kept within
+    /// `max_edge_angle_rad` of their prediction ([`FeatureConfig::max_edge_angle_rad`]) instead
+    /// of the configured ones, which are back in place afterwards, error or not: a search
+    /// refines its leaves under its own
+    /// ([`FinderConfig::leaf_robust`](crate::acquire::FinderConfig::leaf_robust)).
     pub fn track_under(
         &mut self,
         robust: Robust,
+        max_edge_angle_rad: f32,
         frames: &[FrameView<'_>],
     ) -> Result<FrameReport, TrackerError> {
         let own = core::mem::replace(&mut self.config.estimator.robust, robust);
+        let own_angle = core::mem::replace(
+            &mut self.config.features.max_edge_angle_rad,
+            max_edge_angle_rad,
+        );
         let report = self.track(frames);
         self.config.estimator.robust = own;
+        self.config.features.max_edge_angle_rad = own_angle;
         report
     }
 

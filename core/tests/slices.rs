@@ -1,6 +1,8 @@
 //! The 1-D slice search on synthetic profiles with known sub-pixel edge positions.
 
-use digiteyes_core::features::{find_edge, find_valley, Polarity};
+use digiteyes_core::features::{edge_runs_along, find_edge, find_valley, FeatureConfig, Polarity};
+use digiteyes_core::frame::FrameView;
+use nalgebra::Vector2;
 
 /// A box-filtered step from `hi` (inside) to `lo` (outside) at sub-pixel position `edge`,
 /// sampled at pixel centres 0..n: what a pixel sees of an ideal edge.
@@ -127,4 +129,63 @@ fn shallow_valleys_are_rejected() {
         .map(|k| 100.0 + ((k as f32) - 10.0).abs() * 0.2)
         .collect();
     assert!(find_valley(&p, 4.0).is_none());
+}
+
+/// A 64×64 image, bright on the side of the line through (32, 32) opposite `normal` and dark
+/// beyond it, with a one-pixel ramp: an edge whose outward normal is `normal`.
+fn oblique_edge(normal: Vector2<f32>) -> Vec<u8> {
+    let mut image = vec![0u8; 64 * 64];
+    for y in 0..64 {
+        for x in 0..64 {
+            let d = normal.dot(&Vector2::new(x as f32 - 32.0, y as f32 - 32.0));
+            let inside = (0.5 - d).clamp(0.0, 1.0);
+            image[y * 64 + x] = (30.0 + 150.0 * inside) as u8;
+        }
+    }
+    image
+}
+
+#[test]
+fn an_edge_is_kept_only_when_it_runs_along_the_predicted_one() {
+    let limit = 30f32.to_radians().tan();
+    let outward = Vector2::new(1.0f32, 0.0);
+    let centre = Vector2::new(32.0f32, 32.0);
+    for (degrees, kept) in [
+        (0.0f32, true),
+        (20.0, true),
+        (-25.0, true),
+        (40.0, false),
+        (70.0, false),
+        (90.0, false),
+    ] {
+        let a = degrees.to_radians();
+        let image = oblique_edge(Vector2::new(a.cos(), a.sin()));
+        let frame = FrameView::packed(&image, 64, 64).unwrap();
+        assert_eq!(
+            edge_runs_along(&frame, centre, outward, limit),
+            kept,
+            "an edge turned {degrees} degrees from the slice's"
+        );
+    }
+    // Where the stencil leaves the frame there is nothing to judge.
+    let image = oblique_edge(Vector2::new(0.0, 1.0));
+    let frame = FrameView::packed(&image, 64, 64).unwrap();
+    assert!(edge_runs_along(
+        &frame,
+        Vector2::new(0.2, 32.0),
+        outward,
+        limit
+    ));
+}
+
+#[test]
+fn the_angle_limit_is_off_at_a_right_angle_and_the_tangent_below_it() {
+    let mut config = FeatureConfig::default();
+    config.max_edge_angle_rad = core::f32::consts::FRAC_PI_2;
+    assert_eq!(config.edge_tangent_limit(), None, "off at a right angle");
+    config.max_edge_angle_rad = 30f32.to_radians();
+    let limit = config.edge_tangent_limit().unwrap();
+    assert!((limit - 30f32.to_radians().tan()).abs() < 1e-5);
+    config.max_edge_angle_rad = -1.0;
+    assert_eq!(config.edge_tangent_limit(), Some(0.0));
 }

@@ -180,6 +180,7 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             .leaf_robust
             .as_deref()
             .map_or(f.leaf_robust, robust_weight),
+        ..f
     };
     (acquire, finder)
 }

@@ -2,7 +2,7 @@
 //! seed with each variant and prints the track-life distribution per group. A variant is
 //! `default` or `key=value` overrides joined by `+` (keys: `pj`, `pt`, `pq` the prior's
 //! weights; `sj`, `st`, `sq` the conditioning; `iters`, `predict`, `window`, `slices`,
-//! `palm`, `palmw`, `tipw`, `fvf`; `huber`, `tukey` the robust kernel's px; `k`, `s`, `spawn` the hypotheses; `watch` its period).
+//! `palm`, `palmw`, `tipw`, `fvf`; `angle` the edge-direction limit in degrees (90: off); `huber`, `tukey` the robust kernel's px; `k`, `s`, `spawn` the hypotheses; `watch` its period).
 //! Every variant after the first is also compared with the first seed by seed (paired):
 //! the mean change of track life, how many seeds gained or lost more than 5 points, and the
 //! two-sided sign test's p over those (the median of 30 seeds moves by 10–20 points between

@@ -270,10 +270,12 @@ fn acquisition(
     rig: &str,
     seed: u64,
     tracker: TrackerConfig,
+    finder: FinderConfig,
 ) -> (Vec<bool>, String) {
     let sequence = render(dir, rig, seed, 34);
     let truth = sequence.read_truth().unwrap();
     let (mut auto, mut bufs) = search::searching_with(&sequence, AcquireConfig::default(), tracker);
+    auto.set_finder(finder);
     let (mut good, mut line) = (Vec::new(), String::new());
     for k in 0..sequence.frames {
         let images = frames::images(&sequence, k);
@@ -318,7 +320,13 @@ fn the_hand_is_acquired_from_nothing_on_rigs_the_sweep_acquires() {
         ("random-stereo", 104, 15),
         ("random-stereo", 139, 15),
     ] {
-        let (good, line) = acquisition(dir.path(), rig, seed, TrackerConfig::default());
+        let (good, line) = acquisition(
+            dir.path(),
+            rig,
+            seed,
+            TrackerConfig::default(),
+            FinderConfig::default(),
+        );
         println!("{rig} {seed}: {line}");
         assert!(
             acquired_before(&good, before).is_some(),
@@ -338,10 +346,45 @@ fn leaves_are_refined_under_the_searchs_robust_weight_not_the_trackers() {
     let mut tukey = TrackerConfig::default();
     tukey.estimator.robust = Robust::Tukey(5.0);
     assert_ne!(FinderConfig::default().leaf_robust, tukey.estimator.robust);
-    let (good, line) = acquisition(dir.path(), "random-mono", 133, tukey);
+    let (good, line) = acquisition(
+        dir.path(),
+        "random-mono",
+        133,
+        tukey,
+        FinderConfig::default(),
+    );
     println!("random-mono 133 under Tukey 5 px: {line}");
     assert!(
         acquired_before(&good, 30).is_some(),
         "random-mono 133 was not acquired before frame 30 under Tukey: {line}"
+    );
+}
+
+#[test]
+fn leaves_are_refined_without_the_trackers_edge_direction_test() {
+    // A leaf starts turned from the hand, so the image's edges run at an angle to the ones
+    // it predicts: under the tracker's edge-direction test (30 degrees) its refinement
+    // refuses the edges that would pull it in, and `random-mono` seed 133 is not acquired.
+    // Leaves are refined with the test off (`FinderConfig::leaf_max_edge_angle_rad`).
+    let dir = tempfile::tempdir().unwrap();
+    let tracker = TrackerConfig::default();
+    let angle = tracker.features.max_edge_angle_rad;
+    let finder = FinderConfig::default();
+    assert!(angle < finder.leaf_max_edge_angle_rad);
+    let (good, line) = acquisition(dir.path(), "random-mono", 133, tracker, finder);
+    println!("random-mono 133, leaves without the test: {line}");
+    assert!(
+        acquired_before(&good, 30).is_some(),
+        "random-mono 133 not acquired before frame 30: {line}"
+    );
+    let strict = FinderConfig {
+        leaf_max_edge_angle_rad: angle,
+        ..FinderConfig::default()
+    };
+    let (good, line) = acquisition(dir.path(), "random-mono", 133, tracker, strict);
+    println!("random-mono 133, leaves under the tracker's test: {line}");
+    assert!(
+        acquired_before(&good, 30).is_none(),
+        "random-mono 133 acquired with leaves under the tracker's edge test: {line}"
     );
 }

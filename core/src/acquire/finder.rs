@@ -48,6 +48,11 @@ pub struct FinderConfig {
     /// The robust weight of a leaf's refinement, in place of the tracker's own: a leaf starts
     /// several px from the hand, where a weight that falls to zero (Tukey) pulls nothing.
     pub leaf_robust: Robust,
+    /// The edge-direction test of a leaf's refinement, in place of the tracker's own
+    /// ([`FeatureConfig::max_edge_angle_rad`](crate::features::FeatureConfig::max_edge_angle_rad);
+    /// rad, π/2: off): a leaf starts turned from the hand, where the image's edges run at an
+    /// angle to the predicted ones and the test would refuse the edges that pull it in.
+    pub leaf_max_edge_angle_rad: f32,
 }
 
 impl Default for FinderConfig {
@@ -63,6 +68,7 @@ impl Default for FinderConfig {
             alternative_score: 0.85,
             confirm_min_score: 0.0,
             leaf_robust: Robust::Huber(2.0),
+            leaf_max_edge_angle_rad: core::f32::consts::FRAC_PI_2,
         }
     }
 }
@@ -256,7 +262,8 @@ impl Finder {
     }
 
     /// `leaf` refined by the tracker's Gauss–Newton ([`FinderConfig::passes_per_leaf`] fresh
-    /// passes on the frame, weighted by [`FinderConfig::leaf_robust`]), scored in every
+    /// passes on the frame, weighted by [`FinderConfig::leaf_robust`] with the edge test of
+    /// [`FinderConfig::leaf_max_edge_angle_rad`]), scored in every
     /// camera and judged. The tracker keeps its own robust weight afterwards.
     fn refine(
         &mut self,
@@ -266,9 +273,9 @@ impl Finder {
         leaf: &[f32; MAX_STATES],
         n: usize,
     ) -> Result<(Verdict, [f32; MAX_STATES], FrameReport), TrackerError> {
-        let robust = self.config.leaf_robust;
+        let (robust, angle) = (self.config.leaf_robust, self.config.leaf_max_edge_angle_rad);
         tracker.restart_fresh(&leaf[..n])?;
-        let mut report = tracker.track_under(robust, frames)?;
+        let mut report = tracker.track_under(robust, angle, frames)?;
         for _ in 1..self.config.passes_per_leaf.max(1) {
             if report.lost {
                 break;
@@ -279,7 +286,7 @@ impl Finder {
                 *d = *s;
             }
             tracker.restart_fresh(&q[..n])?;
-            report = tracker.track_under(robust, frames)?;
+            report = tracker.track_under(robust, angle, frames)?;
         }
         let mut q = [0.0f32; MAX_STATES];
         for (d, s) in q.iter_mut().zip(tracker.state()) {

@@ -10,7 +10,8 @@
 //! is finger against palm.
 
 use super::{
-    find_edge, EdgePoint, FeatureConfig, LinkFeatures, MIN_WINDOW_SAMPLES, PROBE_BEYOND_EDGE_PX,
+    edge_runs_along, find_edge, EdgePoint, FeatureConfig, LinkFeatures, MIN_WINDOW_SAMPLES,
+    PROBE_BEYOND_EDGE_PX,
 };
 use crate::camera::Camera;
 use crate::config::{MAX_SLICES_PER_LINK, MAX_WINDOW};
@@ -55,6 +56,7 @@ pub fn find_palm_edge_features(
         (heapless::Vec::new(), false)
     };
     let mut profile = [0.0f32; MAX_WINDOW];
+    let tangent_limit = config.edge_tangent_limit();
     for k in 0..slices {
         let s = if slices == 1 {
             0.5 * (config.span[0] + config.span[1])
@@ -80,6 +82,11 @@ pub fn find_palm_edge_features(
         }
         out.expected += 1;
         let Some(found) = find_edge(&profile[..window], config.polarity, config.min_contrast)
+            .filter(|e| {
+                tangent_limit.is_none_or(|limit| {
+                    edge_runs_along(frame, start + outward * e.position, outward, limit)
+                })
+            })
         else {
             continue;
         };

@@ -36,7 +36,9 @@ pub use params::{BadParameter, CameraParams, TrackerParams, WireResidual, WireRo
 /// Version 6: the palm's outline edges (issue 9): `TrackerParams` gained `palm_edges`, and a
 /// board answering `Measure` sends `PalmEdges` (board message 11) per palm outline edge with
 /// anything to say, counted in `Measured::links` (docs/protocol.md §12).
-pub const PROTOCOL_VERSION: u8 = 6;
+/// Version 7: `TrackerParams` gained `max_edge_angle_rad`, the slice search's test of an
+/// edge's direction (issue 9; docs/protocol.md §4).
+pub const PROTOCOL_VERSION: u8 = 7;
 
 /// Largest `FrameChunk` payload (bytes).
 pub const MAX_CHUNK: usize = 1024;

@@ -117,6 +117,10 @@ pub struct TrackerParams {
     /// Slice across the palm box's own image outline too (version 6;
     /// `FeatureConfig::palm_edges`).
     pub palm_edges: bool,
+    /// An edge found is kept only where the image's edge runs within this angle of the
+    /// predicted one (rad, 0–π/2; π/2 keeps every edge; version 7;
+    /// `FeatureConfig::max_edge_angle_rad`).
+    pub max_edge_angle_rad: f32,
 }
 
 /// A tracker parameter out of range.
@@ -158,6 +162,7 @@ impl TrackerParams {
             lost_min_found: config.lost_min_found,
             lost_rms_px: config.lost_rms_px,
             palm_edges: config.features.palm_edges,
+            max_edge_angle_rad: config.features.max_edge_angle_rad,
         }
     }
 
@@ -181,6 +186,10 @@ impl TrackerParams {
         )?;
         check((0.0..=1.0).contains(&self.lost_min_found), "lost_min_found")?;
         check(positive(self.lost_rms_px), "lost_rms_px")?;
+        check(
+            (0.0..=core::f32::consts::FRAC_PI_2).contains(&self.max_edge_angle_rad),
+            "max_edge_angle_rad",
+        )?;
         let robust = match self.robust {
             WireRobust::None => Robust::None,
             WireRobust::Huber(k) if positive(k) => Robust::Huber(k),
@@ -194,6 +203,7 @@ impl TrackerParams {
         features.window_px = self.window_px;
         features.min_contrast = self.min_contrast;
         features.palm_edges = self.palm_edges;
+        features.max_edge_angle_rad = self.max_edge_angle_rad;
         let mut estimator = defaults.estimator;
         estimator.residual = match self.residual {
             WireResidual::EdgePoints => ResidualKind::EdgePoints,

@@ -68,6 +68,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "window" => c.features.window_px = f as u8,
             "slices" => c.features.slices_per_link = f as u8,
             "palm" => c.features.palm_edges = f != 0.0,
+            "angle" => c.features.max_edge_angle_rad = f.to_radians(),
             "fvf" => c.motion.full_velocity_found = f,
             "palmw" => c.estimator.palm_edge_weight = f,
             "sj" => c.estimator.conditioning.joint = f,
