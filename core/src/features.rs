@@ -66,8 +66,9 @@ pub struct FeatureConfig {
     /// angle of the predicted one (rad): the gradient's component along the predicted edge is
     /// at most `tan(angle)` of its component across it ([`edge_runs_along`]). A slice that
     /// crosses another finger's or the palm's outline at an angle then finds nothing rather
-    /// than that outline. `π/2` or more keeps every edge. Default 30°, judged on the sweep
-    /// (`docs/robustness.md`).
+    /// than that outline. `π/2` or more keeps every edge: the default. 30° lengthens track
+    /// life on the sweep but doubles a frame's instructions (`docs/robustness.md`,
+    /// `docs/performance.md`), over issue 9's budget, so it is not on by default yet.
     pub max_edge_angle_rad: f32,
 }
 
@@ -84,7 +85,7 @@ impl Default for FeatureConfig {
             mask_occluded: true,
             tips: true,
             palm_edges: true,
-            max_edge_angle_rad: 30.0 * core::f32::consts::PI / 180.0,
+            max_edge_angle_rad: core::f32::consts::FRAC_PI_2,
         }
     }
 }

@@ -56,6 +56,10 @@ struct Args {
     /// Residual form (default: the tracker's).
     #[arg(long, value_enum)]
     residual: Option<Residual>,
+    /// The slice search's edge-direction limit (degrees; 90: every edge kept; default: the
+    /// tracker's), to cost the test.
+    #[arg(long)]
+    edge_angle_deg: Option<f32>,
     /// The thesis' plain loop: no motion model, no silhouette check (the cost before them).
     #[arg(long)]
     plain: bool,
@@ -91,6 +95,9 @@ fn main() -> Result<()> {
     }
     if let Some(slices) = args.slices {
         config.features.slices_per_link = slices;
+    }
+    if let Some(degrees) = args.edge_angle_deg {
+        config.features.max_edge_angle_rad = degrees.to_radians();
     }
     if let Some(window) = args.window {
         config.features.window_px = window;

@@ -363,11 +363,12 @@ fn leaves_are_refined_under_the_searchs_robust_weight_not_the_trackers() {
 #[test]
 fn leaves_are_refined_without_the_trackers_edge_direction_test() {
     // A leaf starts turned from the hand, so the image's edges run at an angle to the ones
-    // it predicts: under the tracker's edge-direction test (30 degrees) its refinement
+    // it predicts: under a tracker's edge-direction test of 30 degrees its refinement
     // refuses the edges that would pull it in, and `random-mono` seed 133 is not acquired.
     // Leaves are refined with the test off (`FinderConfig::leaf_max_edge_angle_rad`).
     let dir = tempfile::tempdir().unwrap();
-    let tracker = TrackerConfig::default();
+    let mut tracker = TrackerConfig::default();
+    tracker.features.max_edge_angle_rad = 30f32.to_radians();
     let angle = tracker.features.max_edge_angle_rad;
     let finder = FinderConfig::default();
     assert!(angle < finder.leaf_max_edge_angle_rad);
