@@ -98,6 +98,17 @@ impl FeatureConfig {
     }
 }
 
+/// Whether an edge found at `p` on a window stepping `outward` is kept under `limit`
+/// ([`FeatureConfig::edge_tangent_limit`]; `None` keeps every edge).
+pub(crate) fn edge_kept(
+    frame: &FrameView<'_>,
+    limit: Option<f32>,
+    p: Vector2<f32>,
+    outward: Vector2<f32>,
+) -> bool {
+    limit.is_none_or(|limit| edge_runs_along(frame, p, outward, limit))
+}
+
 /// Whether the image's edge at `p` runs along the predicted edge, whose outward normal is
 /// `outward` (a unit vector): the intensity gradient, by a 3×3 Sobel turned to the slice,
 /// has a component along the edge at most `limit` times its component across it. True where
@@ -440,11 +451,8 @@ fn search_link<W: FnMut(&SearchWindow)>(
         } else {
             find_edge(&profile[..window], config.polarity, config.min_contrast)
         };
-        let edge = edge.filter(|e| {
-            tangent_limit.is_none_or(|limit| {
-                edge_runs_along(frame, start + outward * e.position, outward, limit)
-            })
-        });
+        let edge =
+            edge.filter(|e| edge_kept(frame, tangent_limit, start + outward * e.position, outward));
         let Some(edge) = edge else {
             watched(WindowOutcome::NoEdge);
             return None;

@@ -451,6 +451,24 @@ fn version_3_state_and_reset_are_decode_errors() {
     assert_eq!(rx.counters().decode_errors, 1);
 }
 
+/// `old`, a `Configure` as an older host sends it, is a decode error here (counted, nothing
+/// answered), and today's `Configure` is `grown` bytes longer, for `why`.
+fn an_older_configure_is_a_decode_error(old: &[u8], grown: usize, why: &str) {
+    let mut rx = Decoder::<MAX_MESSAGE>::new();
+    let (used, out) = rx.feed::<HostMessage>(old);
+    assert_eq!(used, old.len());
+    assert!(matches!(out, Some(Err(LinkError::Decode))), "{out:?}");
+    assert_eq!(rx.counters().decode_errors, 1);
+    let mut buf = [0u8; MAX_MESSAGE];
+    let today = host_messages(&PIXELS)
+        .into_iter()
+        .find(|(name, _)| *name == "Configure")
+        .unwrap()
+        .1;
+    let frame = encode(&today, &mut buf).unwrap();
+    assert_eq!(frame.len(), old.len() + grown, "{why}");
+}
+
 /// Version 6's `Configure` (no `max_edge_angle_rad` in its tracker parameters), as a version 6
 /// host sends it: a version 7 board counts it as a decode error and answers nothing.
 #[test]
@@ -465,23 +483,7 @@ fn version_6_configure_is_a_decode_error() {
         0x03, 0x80, 0x3f, 0x01, 0x07, 0x7a, 0x44, 0x9a, 0x99, 0x99, 0x3e, 0x01, 0x04, 0xc0, 0x40,
         0x01, 0x09, 0x1e, 0xe8, 0x07, 0x04, 0xc1, 0xc3, 0x7d, 0xd3, 0x00,
     ];
-    let mut rx = Decoder::<MAX_MESSAGE>::new();
-    let (used, out) = rx.feed::<HostMessage>(V6_CONFIGURE);
-    assert_eq!(used, V6_CONFIGURE.len());
-    assert!(matches!(out, Some(Err(LinkError::Decode))), "{out:?}");
-    assert_eq!(rx.counters().decode_errors, 1);
-    let mut buf = [0u8; MAX_MESSAGE];
-    let v7 = host_messages(&PIXELS)
-        .into_iter()
-        .find(|(name, _)| *name == "Configure")
-        .unwrap()
-        .1;
-    let frame = encode(&v7, &mut buf).unwrap();
-    assert_eq!(
-        frame.len(),
-        V6_CONFIGURE.len() + 4,
-        "four bytes more: the angle's f32"
-    );
+    an_older_configure_is_a_decode_error(V6_CONFIGURE, 4, "four bytes more: the angle's f32");
 }
 
 /// Version 5's `Configure` (no `palm_edges` in its tracker parameters), as a version 5 host
@@ -498,22 +500,10 @@ fn version_5_configure_is_a_decode_error() {
         0x03, 0x80, 0x3f, 0x01, 0x07, 0x7a, 0x44, 0x9a, 0x99, 0x99, 0x3e, 0x01, 0x03, 0xc0, 0x40,
         0x09, 0x1e, 0xe8, 0x07, 0x04, 0xa2, 0xf2, 0x5d, 0xd8, 0x00,
     ];
-    let mut rx = Decoder::<MAX_MESSAGE>::new();
-    let (used, out) = rx.feed::<HostMessage>(V5_CONFIGURE);
-    assert_eq!(used, V5_CONFIGURE.len());
-    assert!(matches!(out, Some(Err(LinkError::Decode))), "{out:?}");
-    assert_eq!(rx.counters().decode_errors, 1);
-    let mut buf = [0u8; MAX_MESSAGE];
-    let v6 = host_messages(&PIXELS)
-        .into_iter()
-        .find(|(name, _)| *name == "Configure")
-        .unwrap()
-        .1;
-    let frame = encode(&v6, &mut buf).unwrap();
-    assert_eq!(
-        frame.len(),
-        V5_CONFIGURE.len() + 1 + 4,
-        "one byte more for the flag, four for version 7's angle"
+    an_older_configure_is_a_decode_error(
+        V5_CONFIGURE,
+        1 + 4,
+        "one byte more for the flag, four for version 7's angle",
     );
 }
 
@@ -532,21 +522,11 @@ fn version_4_configure_is_a_decode_error() {
         0x03, 0x80, 0x3f, 0x01, 0x07, 0x7a, 0x44, 0x9a, 0x99, 0x99, 0x3e, 0x01, 0x03, 0xc0, 0x40,
         0x08, 0x1e, 0xe8, 0x07, 0x8a, 0x08, 0xb3, 0x5f, 0x00,
     ];
-    let mut rx = Decoder::<MAX_MESSAGE>::new();
-    let (used, out) = rx.feed::<HostMessage>(V4_CONFIGURE);
-    assert_eq!(used, V4_CONFIGURE.len());
-    assert!(matches!(out, Some(Err(LinkError::Decode))), "{out:?}");
-    assert_eq!(rx.counters().decode_errors, 1);
-    // The same bytes with the count appended (and the CRC and COBS redone) decode.
-    let mut buf = [0u8; MAX_MESSAGE];
-    let v5 = host_messages(&PIXELS)
-        .into_iter()
-        .find(|(name, _)| *name == "Configure")
-        .unwrap()
-        .1;
-    let frame = encode(&v5, &mut buf).unwrap();
-    // The count, version 6's palm flag and version 7's angle.
-    assert_eq!(frame.len(), V4_CONFIGURE.len() + 2 + 4);
+    an_older_configure_is_a_decode_error(
+        V4_CONFIGURE,
+        2 + 4,
+        "the count, version 6's palm flag and version 7's angle",
+    );
 }
 
 /// The spec's worked example of the model digest (§7), computed from the bytes written out

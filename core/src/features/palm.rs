@@ -10,7 +10,7 @@
 //! is finger against palm.
 
 use super::{
-    edge_runs_along, find_edge, EdgePoint, FeatureConfig, LinkFeatures, MIN_WINDOW_SAMPLES,
+    edge_kept, find_edge, EdgePoint, FeatureConfig, LinkFeatures, MIN_WINDOW_SAMPLES,
     PROBE_BEYOND_EDGE_PX,
 };
 use crate::camera::Camera;
@@ -82,11 +82,7 @@ pub fn find_palm_edge_features(
         }
         out.expected += 1;
         let Some(found) = find_edge(&profile[..window], config.polarity, config.min_contrast)
-            .filter(|e| {
-                tangent_limit.is_none_or(|limit| {
-                    edge_runs_along(frame, start + outward * e.position, outward, limit)
-                })
-            })
+            .filter(|e| edge_kept(frame, tangent_limit, start + outward * e.position, outward))
         else {
             continue;
         };
