@@ -20,8 +20,10 @@ use crate::visibility::{candidates, cover_among, Cover};
 
 mod axis_line;
 mod palm;
+mod refusals;
 pub use axis_line::fit_axis_line;
-pub use palm::find_palm_edge_features;
+pub use palm::{find_palm_edge_features, find_palm_edge_features_refusing};
+pub use refusals::RefusedWindows;
 
 /// Which sign of intensity change, going outward across an edge, counts as an edge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -66,9 +68,10 @@ pub struct FeatureConfig {
     /// angle of the predicted one (rad): the gradient's component along the predicted edge is
     /// at most `tan(angle)` of its component across it ([`edge_runs_along`]). A slice that
     /// crosses another finger's or the palm's outline at an angle then finds nothing rather
-    /// than that outline. `π/2` or more keeps every edge: the default. 30° lengthens track
-    /// life on the sweep but doubles a frame's instructions (`docs/robustness.md`,
-    /// `docs/performance.md`), over issue 9's budget, so it is not on by default yet.
+    /// than that outline, and a window refused once stays refused for the rest of the frame
+    /// ([`RefusedWindows`]). `π/2` or more keeps every edge. Default 30°: track life +5.6
+    /// points on 240 fresh seeds for 11 % more instructions per frame (`docs/robustness.md`,
+    /// `docs/performance.md`).
     pub max_edge_angle_rad: f32,
 }
 
@@ -85,7 +88,7 @@ impl Default for FeatureConfig {
             mask_occluded: true,
             tips: true,
             palm_edges: true,
-            max_edge_angle_rad: core::f32::consts::FRAC_PI_2,
+            max_edge_angle_rad: core::f32::consts::FRAC_PI_6,
         }
     }
 }
@@ -98,40 +101,48 @@ impl FeatureConfig {
     }
 }
 
-/// Whether an edge found at `p` on a window stepping `outward` is kept under `limit`
-/// ([`FeatureConfig::edge_tangent_limit`]; `None` keeps every edge).
+/// Whether an edge found at `p` on search window `window` (a [`RefusedWindows`] bit), stepping
+/// `outward`, is kept: not refused earlier in the frame, and running along the predicted edge
+/// under `limit` ([`FeatureConfig::edge_tangent_limit`]; `None` keeps every edge). A window
+/// refused now is added to `refused`, and stays refused without a look.
 pub(crate) fn edge_kept(
     frame: &FrameView<'_>,
     limit: Option<f32>,
+    refused: &mut RefusedWindows,
+    window: u32,
     p: Vector2<f32>,
     outward: Vector2<f32>,
 ) -> bool {
-    limit.is_none_or(|limit| edge_runs_along(frame, p, outward, limit))
+    if refused.contains(window) {
+        return false;
+    }
+    let kept = limit.is_none_or(|limit| edge_runs_along(frame, p, outward, limit));
+    if !kept {
+        refused.insert(window);
+    }
+    kept
 }
 
 /// Whether the image's edge at `p` runs along the predicted edge, whose outward normal is
-/// `outward` (a unit vector): the intensity gradient, by a 3×3 Sobel turned to the slice,
-/// has a component along the edge at most `limit` times its component across it. True where
-/// the stencil leaves the frame (nothing to judge).
+/// `outward` (a unit vector): the intensity gradient at the nearest pixel, by a 3×3 Sobel
+/// ([`FrameView::sobel`]), has a component along the edge at most `limit` times its
+/// component across it. True where the stencil leaves the frame (nothing to judge).
 pub fn edge_runs_along(
     frame: &FrameView<'_>,
     p: Vector2<f32>,
     outward: Vector2<f32>,
     limit: f32,
 ) -> bool {
-    let along = Vector2::new(-outward.y, outward.x);
-    let at = |a: f32, b: f32| frame.sample_vec(p + outward * a + along * b);
-    let mut across = 0.0f32;
-    let mut tangent = 0.0f32;
-    for (w, o) in [(1.0f32, -1.0f32), (2.0, 0.0), (1.0, 1.0)] {
-        let (Some(out_n), Some(in_n), Some(out_t), Some(in_t)) =
-            (at(1.0, o), at(-1.0, o), at(o, 1.0), at(o, -1.0))
-        else {
-            return true;
-        };
-        across += w * (out_n - in_n);
-        tangent += w * (out_t - in_t);
+    let (x, y) = (libm::roundf(p.x), libm::roundf(p.y));
+    if !(x >= 0.0 && y >= 0.0 && x < frame.width() as f32 && y < frame.height() as f32) {
+        return true;
     }
+    let Some([dx, dy]) = frame.sobel(x as usize, y as usize) else {
+        return true;
+    };
+    let (dx, dy) = (dx as f32, dy as f32);
+    let across = dx * outward.x + dy * outward.y;
+    let tangent = dy * outward.x - dx * outward.y;
     libm::fabsf(tangent) <= limit * libm::fabsf(across)
 }
 
@@ -324,7 +335,6 @@ pub struct SearchWindow {
 }
 
 /// Runs the slice and tip searches for link `index` of `view` on `frame`, into `out`.
-#[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
 pub fn find_link_features(
     view: &ProjectedModel,
     camera: &Camera,
@@ -333,7 +343,43 @@ pub fn find_link_features(
     config: &FeatureConfig,
     out: &mut LinkFeatures,
 ) {
-    search_link(view, camera, frame, index, config, out, &mut |_| {});
+    let mut refused = RefusedWindows::NONE;
+    search_link(
+        view,
+        camera,
+        frame,
+        index,
+        config,
+        &mut refused,
+        out,
+        &mut |_| {},
+    );
+}
+
+/// [`find_link_features`] across the iterations of one frame: windows in `refused` (refused
+/// by the direction test earlier in the frame) stay refused, and windows refused now are
+/// added ([`RefusedWindows`]).
+#[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
+#[allow(clippy::too_many_arguments)]
+pub fn find_link_features_refusing(
+    view: &ProjectedModel,
+    camera: &Camera,
+    frame: &FrameView<'_>,
+    index: usize,
+    config: &FeatureConfig,
+    refused: &mut RefusedWindows,
+    out: &mut LinkFeatures,
+) {
+    search_link(
+        view,
+        camera,
+        frame,
+        index,
+        config,
+        refused,
+        out,
+        &mut |_| {},
+    );
 }
 
 /// [`find_link_features`], also handing `watch` every search window it considered, in
@@ -349,17 +395,29 @@ pub fn find_link_features_watched(
     out: &mut LinkFeatures,
     mut watch: impl FnMut(&SearchWindow),
 ) {
-    search_link(view, camera, frame, index, config, out, &mut watch);
+    let mut refused = RefusedWindows::NONE;
+    search_link(
+        view,
+        camera,
+        frame,
+        index,
+        config,
+        &mut refused,
+        out,
+        &mut watch,
+    );
 }
 
 /// The one body of both searches; with a no-op `watch` it compiles to the plain search.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn search_link<W: FnMut(&SearchWindow)>(
     view: &ProjectedModel,
     camera: &Camera,
     frame: &FrameView<'_>,
     index: usize,
     config: &FeatureConfig,
+    refused: &mut RefusedWindows,
     out: &mut LinkFeatures,
     watch: &mut W,
 ) {
@@ -406,8 +464,9 @@ fn search_link<W: FnMut(&SearchWindow)>(
     let mut search = |centre: Vector2<f32>,
                       outward: Vector2<f32>,
                       depth: f32,
-                      tip: bool,
+                      window_bit: u32,
                       out: &mut LinkFeatures| {
+        let tip = window_bit == RefusedWindows::TIP;
         let mut watched = |outcome| {
             watch(&SearchWindow {
                 start: centre - outward * half,
@@ -451,8 +510,10 @@ fn search_link<W: FnMut(&SearchWindow)>(
         } else {
             find_edge(&profile[..window], config.polarity, config.min_contrast)
         };
-        let edge =
-            edge.filter(|e| edge_kept(frame, tangent_limit, start + outward * e.position, outward));
+        let edge = edge.filter(|e| {
+            let at = start + outward * e.position;
+            edge_kept(frame, tangent_limit, refused, window_bit, at, outward)
+        });
         let Some(edge) = edge else {
             watched(WindowOutcome::NoEdge);
             return None;
@@ -468,7 +529,13 @@ fn search_link<W: FnMut(&SearchWindow)>(
         for side in [1i8, -1] {
             let outward = normal * f32::from(side);
             let predicted = axis_point + outward * link.side_radius_at(s, side);
-            if let Some((position, strength)) = search(predicted, outward, depth, false, out) {
+            if let Some((position, strength)) = search(
+                predicted,
+                outward,
+                depth,
+                RefusedWindows::slice(k, side),
+                out,
+            ) {
                 let _ = out.edges.push(EdgePoint {
                     s,
                     side,
@@ -480,7 +547,7 @@ fn search_link<W: FnMut(&SearchWindow)>(
     }
     if config.tips && link.distal {
         let predicted = link.b + dir * link.tip_offset;
-        if let Some((position, _)) = search(predicted, dir, link.z1, true, out) {
+        if let Some((position, _)) = search(predicted, dir, link.z1, RefusedWindows::TIP, out) {
             out.tip = Some(position);
         }
     }

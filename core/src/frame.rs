@@ -146,6 +146,27 @@ impl<'a> FrameView<'a> {
         Some(top + (bottom - top) * fy)
     }
 
+    /// The 3×3 Sobel gradient `[∂x, ∂y]` at pixel `(x, y)` (grey levels × 8 per px), or
+    /// `None` where the stencil would leave the frame. Eight byte loads, no interpolation.
+    pub fn sobel(&self, x: usize, y: usize) -> Option<[i32; 2]> {
+        if x == 0
+            || y == 0
+            || x >= self.width.saturating_sub(1)
+            || y >= self.height.saturating_sub(1)
+        {
+            return None;
+        }
+        let row = |yy: usize| -> Option<[i32; 3]> {
+            let at = yy * self.stride + x;
+            let r = self.data.get(at - 1..=at + 1)?;
+            Some([i32::from(r[0]), i32::from(r[1]), i32::from(r[2])])
+        };
+        let (up, mid, down) = (row(y - 1)?, row(y)?, row(y + 1)?);
+        let dx = (up[2] - up[0]) + 2 * (mid[2] - mid[0]) + (down[2] - down[0]);
+        let dy = (down[0] - up[0]) + 2 * (down[1] - up[1]) + (down[2] - up[2]);
+        Some([dx, dy])
+    }
+
     /// [`FrameView::sample`] at a point.
     pub fn sample_vec(&self, p: Vector2<f32>) -> Option<f32> {
         self.sample(p.x, p.y)

@@ -1,6 +1,8 @@
 //! One camera's slice search across the iterations of a frame: the first iteration searches
 //! every link with the configured window; later ones narrow each link's window to what its
-//! last search needed (coarse to fine), so a frame's later iterations cost less.
+//! last search needed (coarse to fine), so a frame's later iterations cost less. A window
+//! whose edge the direction test refused stays refused for the rest of the frame
+//! ([`RefusedWindows`]).
 //!
 //! The in-process tracker keeps one per camera; a board measuring for a stereo host
 //! ([`measurer`](crate::measurer)) keeps its own, so both narrow the windows alike.
@@ -8,7 +10,8 @@
 use crate::camera::Camera;
 use crate::config::MAX_LINKS;
 use crate::features::{
-    find_link_features, find_palm_edge_features, FeatureConfig, LinkFeatures, MIN_WINDOW_SAMPLES,
+    find_link_features_refusing, find_palm_edge_features_refusing, FeatureConfig, LinkFeatures,
+    RefusedWindows, MIN_WINDOW_SAMPLES,
 };
 use crate::frame::FrameView;
 use crate::palm_outline::HullEdge;
@@ -17,7 +20,7 @@ use crate::projection::{ProjectedModel, BOX_CORNERS};
 /// Pairs of box corners a palm hull edge may join, numbered `8 · low + high`.
 const CORNER_PAIRS: usize = BOX_CORNERS * BOX_CORNERS;
 
-/// The reach of each link's last search in the current frame.
+/// The reach of each link's last search in the current frame, and the windows refused in it.
 #[derive(Debug, Clone, Copy)]
 pub struct CameraSearch {
     /// `reach_px[link]`: how far from its prediction the last search of model link `link`
@@ -26,6 +29,10 @@ pub struct CameraSearch {
     /// `palm_reach_px[8 · low + high]`: the same for the palm's hull edge joining box corners
     /// `low` < `high` (px); infinite when unknown.
     palm_reach_px: [f32; CORNER_PAIRS],
+    /// `refused[link]`: the windows of model link `link` refused this frame.
+    refused: [RefusedWindows; MAX_LINKS],
+    /// `palm_refused[8 · low + high]`: the same for a palm hull edge.
+    palm_refused: [RefusedWindows; CORNER_PAIRS],
 }
 
 impl Default for CameraSearch {
@@ -40,13 +47,15 @@ impl CameraSearch {
         CameraSearch {
             reach_px: [f32::INFINITY; MAX_LINKS],
             palm_reach_px: [f32::INFINITY; CORNER_PAIRS],
+            refused: [RefusedWindows::NONE; MAX_LINKS],
+            palm_refused: [RefusedWindows::NONE; CORNER_PAIRS],
         }
     }
 
-    /// Forgets the reaches: the next searches use the configured windows (a new frame).
+    /// Forgets the reaches and the refusals: the next searches use the configured windows
+    /// and judge every edge afresh (a new frame).
     pub fn restart(&mut self) {
-        self.reach_px = [f32::INFINITY; MAX_LINKS];
-        self.palm_reach_px = [f32::INFINITY; CORNER_PAIRS];
+        *self = Self::new();
     }
 
     /// Searches link `index` of `view` on `frame` into `out`. With `refine`, the window is
@@ -73,7 +82,9 @@ impl CameraSearch {
             .copied()
             .unwrap_or(f32::INFINITY);
         let features = narrowed(config, refine, reach);
-        find_link_features(view, camera, frame, index, &features, out);
+        let mut none = RefusedWindows::NONE;
+        let refused = self.refused.get_mut(link_frame).unwrap_or(&mut none);
+        find_link_features_refusing(view, camera, frame, index, &features, refused, out);
         let found = out.edges.len() as u16 + u16::from(out.tip.is_some());
         if let Some(r) = self.reach_px.get_mut(link_frame) {
             *r = if found == 0 {
@@ -108,7 +119,9 @@ impl CameraSearch {
             .copied()
             .unwrap_or(f32::INFINITY);
         let features = narrowed(config, refine, reach);
-        find_palm_edge_features(view, camera, frame, edge, &features, out);
+        let mut none = RefusedWindows::NONE;
+        let refused = self.palm_refused.get_mut(pair).unwrap_or(&mut none);
+        find_palm_edge_features_refusing(view, camera, frame, edge, &features, refused, out);
         let found = out.edges.len() as u16;
         if let Some(r) = self.palm_reach_px.get_mut(pair) {
             *r = if found == 0 {

@@ -243,3 +243,26 @@ fn sample_segment_in_and_out_of_bounds() {
     assert!(f.sample_segment(Vector2::new(2.5, 0.5), Vector2::new(100.0, 100.0), &mut one));
     assert_eq!(one[0], ramp(2.5, 0.5));
 }
+
+#[test]
+fn sobel_reads_the_ramp_gradient_and_nothing_past_the_border() {
+    let (w, h, stride) = (9, 7, 12);
+    let data = ramp_image(w, h, stride);
+    let frame = FrameView::new(&data, w, h, stride).unwrap();
+    // 4 × (I[x+1] − I[x−1]) = 8 × the slope, exactly, on every inner pixel.
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            assert_eq!(frame.sobel(x, y), Some([3 * 8, 7 * 8]), "({x}, {y})");
+        }
+    }
+    for (x, y) in [
+        (0, 3),
+        (w - 1, 3),
+        (4, 0),
+        (4, h - 1),
+        (w, 3),
+        (usize::MAX, usize::MAX),
+    ] {
+        assert_eq!(frame.sobel(x, y), None, "({x}, {y})");
+    }
+}

@@ -1,10 +1,12 @@
 //! `find_link_features_watched`: the same features as the tracker's `find_link_features`,
-//! bit for bit, and one reported window per slice and tip search, accounted as the counters.
+//! bit for bit, and one reported window per slice and tip search, accounted as the counters;
+//! `find_link_features_refusing`: windows the edge-direction test refused earlier in a frame
+//! stay refused.
 
 use digiteyes_core::camera::Camera;
 use digiteyes_core::features::{
-    find_link_features, find_link_features_watched, FeatureConfig, LinkFeatures, SearchWindow,
-    WindowOutcome,
+    find_link_features, find_link_features_refusing, find_link_features_watched, FeatureConfig,
+    LinkFeatures, RefusedWindows, SearchWindow, WindowOutcome,
 };
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
@@ -99,4 +101,96 @@ fn watched_search_finds_the_same_features_and_reports_every_window() {
     }
     assert!(masked > 0, "the pose hides some slices");
     assert!(found_any > 20, "{found_any} edges found");
+}
+
+/// Edges and tips found.
+fn found(f: &LinkFeatures) -> usize {
+    f.edges.len() + usize::from(f.tip.is_some())
+}
+
+/// A crude frame of the bent pose, and the projection of a prediction off by `offset_rad` in
+/// every joint (so many predicted edges cross the painted ones at an angle).
+fn off_prediction(offset_rad: f32) -> (Camera, Vec<u8>, ProjectedModel) {
+    let model = Model::hand().unwrap();
+    let camera = camera();
+    let truth = pose();
+    let mut view = ProjectedModel::new();
+    view.update(
+        &model,
+        &Poses::compute(&model, &truth).unwrap(),
+        &camera,
+        6.0,
+    );
+    let pixels = paint(&view, &camera);
+    let predicted: Vec<f32> = truth
+        .iter()
+        .enumerate()
+        .map(|(i, q)| if i >= 7 { q + offset_rad } else { *q })
+        .collect();
+    view.update(
+        &model,
+        &Poses::compute(&model, &predicted).unwrap(),
+        &camera,
+        6.0,
+    );
+    (camera, pixels, view)
+}
+
+/// The slice search with the edge-direction test at 30° and off.
+fn on_and_off() -> (FeatureConfig, FeatureConfig) {
+    let mut on = FeatureConfig::default();
+    on.max_edge_angle_rad = 30f32.to_radians();
+    let mut off = on;
+    off.max_edge_angle_rad = core::f32::consts::FRAC_PI_2;
+    (on, off)
+}
+
+#[test]
+fn windows_refused_earlier_in_the_frame_stay_refused() {
+    let (camera, pixels, view) = off_prediction(0.3);
+    let frame = FrameView::packed(&pixels, 640, 480).unwrap();
+    let (on, off) = on_and_off();
+    let mut everything = RefusedWindows::NONE;
+    for bit in 0..=RefusedWindows::TIP {
+        everything.insert(bit);
+    }
+    let mut refused_anywhere = 0;
+    for index in 0..view.links.len() {
+        let search = |config: &FeatureConfig, refused: &mut RefusedWindows| {
+            let mut out = LinkFeatures::default();
+            find_link_features_refusing(&view, &camera, &frame, index, config, refused, &mut out);
+            out
+        };
+        let plain = |config: &FeatureConfig| {
+            let mut out = LinkFeatures::default();
+            find_link_features(&view, &camera, &frame, index, config, &mut out);
+            out
+        };
+        // A fresh frame judges every edge as the one-off search does, and records exactly
+        // the windows whose edge it refused.
+        let mut refused = RefusedWindows::NONE;
+        let first = search(&on, &mut refused);
+        assert_eq!(first.edges, plain(&on).edges, "link {index}");
+        assert_eq!(first.tip, plain(&on).tip, "link {index}");
+        let without_test = plain(&off);
+        assert_eq!(
+            refused.count() as usize,
+            found(&without_test) - found(&first),
+            "link {index}"
+        );
+        refused_anywhere += refused.count();
+        // Searched again in the same frame, the same windows stay refused.
+        let mut again = refused;
+        assert_eq!(search(&on, &mut again).edges, first.edges);
+        assert_eq!(again, refused);
+        // Windows refused earlier are not looked at again, but still count as expected.
+        let none = search(&on, &mut everything.clone());
+        assert_eq!(found(&none), 0, "link {index}");
+        assert_eq!(none.expected, without_test.expected);
+        // With the test off, nothing is refused.
+        let mut unrefused = RefusedWindows::NONE;
+        search(&off, &mut unrefused);
+        assert_eq!(unrefused, RefusedWindows::NONE, "link {index}");
+    }
+    assert!(refused_anywhere > 5, "{refused_anywhere} windows refused");
 }

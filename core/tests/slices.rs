@@ -148,25 +148,30 @@ fn oblique_edge(normal: Vector2<f32>) -> Vec<u8> {
 #[test]
 fn an_edge_is_kept_only_when_it_runs_along_the_predicted_one() {
     let limit = 30f32.to_radians().tan();
-    let outward = Vector2::new(1.0f32, 0.0);
     let centre = Vector2::new(32.0f32, 32.0);
-    for (degrees, kept) in [
-        (0.0f32, true),
-        (20.0, true),
-        (-25.0, true),
-        (40.0, false),
-        (70.0, false),
-        (90.0, false),
-    ] {
-        let a = degrees.to_radians();
-        let image = oblique_edge(Vector2::new(a.cos(), a.sin()));
-        let frame = FrameView::packed(&image, 64, 64).unwrap();
-        assert_eq!(
-            edge_runs_along(&frame, centre, outward, limit),
-            kept,
-            "an edge turned {degrees} degrees from the slice's"
-        );
+    // Slices along the image axes and oblique to them: the stencil is the image's.
+    for slice_deg in [0.0f32, 37.0, 135.0, -100.0] {
+        let s = slice_deg.to_radians();
+        let outward = Vector2::new(s.cos(), s.sin());
+        for (degrees, kept) in [
+            (0.0f32, true),
+            (20.0, true),
+            (-25.0, true),
+            (40.0, false),
+            (70.0, false),
+            (90.0, false),
+        ] {
+            let a = s + degrees.to_radians();
+            let image = oblique_edge(Vector2::new(a.cos(), a.sin()));
+            let frame = FrameView::packed(&image, 64, 64).unwrap();
+            assert_eq!(
+                edge_runs_along(&frame, centre, outward, limit),
+                kept,
+                "an edge turned {degrees} degrees from a slice at {slice_deg} degrees"
+            );
+        }
     }
+    let outward = Vector2::new(1.0f32, 0.0);
     // Where the stencil leaves the frame there is nothing to judge.
     let image = oblique_edge(Vector2::new(0.0, 1.0));
     let frame = FrameView::packed(&image, 64, 64).unwrap();
@@ -181,14 +186,13 @@ fn an_edge_is_kept_only_when_it_runs_along_the_predicted_one() {
 #[test]
 fn the_angle_limit_is_off_at_a_right_angle_and_the_tangent_below_it() {
     let mut config = FeatureConfig::default();
-    assert_eq!(
-        config.edge_tangent_limit(),
-        None,
-        "off by default: a right angle"
+    let limit = config.edge_tangent_limit().expect("on by default");
+    assert!(
+        (limit - 30f32.to_radians().tan()).abs() < 1e-5,
+        "30 degrees by default"
     );
-    config.max_edge_angle_rad = 30f32.to_radians();
-    let limit = config.edge_tangent_limit().unwrap();
-    assert!((limit - 30f32.to_radians().tan()).abs() < 1e-5);
+    config.max_edge_angle_rad = core::f32::consts::FRAC_PI_2;
+    assert_eq!(config.edge_tangent_limit(), None, "off at a right angle");
     config.max_edge_angle_rad = -1.0;
     assert_eq!(config.edge_tangent_limit(), Some(0.0));
 }

@@ -107,6 +107,12 @@ struct Args {
     /// The robust weight leaves are refined under: `huber=K`, `tukey=C` (px) or `none`.
     #[arg(long)]
     leaf_robust: Option<String>,
+    /// The edge-direction limit leaves are refined under (degrees; 90: off, the default).
+    #[arg(long)]
+    leaf_angle_deg: Option<f32>,
+    /// The tracker's own edge-direction limit (degrees; 90: off; default: the tracker's).
+    #[arg(long)]
+    angle_deg: Option<f32>,
     /// Write every refined leaf's judgement and true error here (CSV).
     #[arg(long)]
     leaves_csv: Option<std::path::PathBuf>,
@@ -180,9 +186,23 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             .leaf_robust
             .as_deref()
             .map_or(f.leaf_robust, robust_weight),
-        ..f
+        leaf_max_edge_angle_rad: args
+            .leaf_angle_deg
+            .map_or(f.leaf_max_edge_angle_rad, f32::to_radians),
     };
     (acquire, finder)
+}
+
+/// The tracker's edge-direction limit, when `--angle-deg` gives one (set once in `main`).
+static TRACKER_ANGLE_DEG: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
+
+/// The tracker's defaults, with `--angle-deg` if given.
+fn tracker_config() -> TrackerConfig {
+    let mut config = TrackerConfig::default();
+    if let Some(degrees) = TRACKER_ANGLE_DEG.get() {
+        config.features.max_edge_angle_rad = degrees.to_radians();
+    }
+    config
 }
 
 /// `huber=K`, `tukey=C` or `none`; anything else is the default leaves' weight.
@@ -271,7 +291,7 @@ fn new_finder(sequence: &Sequence, base: &[f32], args: &Args) -> Result<(Tracker
         &sequence.cameras,
         base,
         sequence.free_mask(),
-        TrackerConfig::default(),
+        tracker_config(),
     )
     .map_err(|e| anyhow!("{e}"))?;
     let volume = WorkingVolume::from_cameras(&sequence.cameras, 600.0);
@@ -291,7 +311,7 @@ fn auto_tracker(sequence: &Sequence, args: &Args, initial: Option<&[f32]>) -> Re
             &sequence.cameras,
             &base,
             sequence.free_mask(),
-            TrackerConfig::default(),
+            tracker_config(),
             acquire,
         ),
         Some(q) => AutoTracker::tracking(
@@ -299,7 +319,7 @@ fn auto_tracker(sequence: &Sequence, args: &Args, initial: Option<&[f32]>) -> Re
             &sequence.cameras,
             q,
             sequence.free_mask(),
-            TrackerConfig::default(),
+            tracker_config(),
             acquire,
         ),
     }
@@ -539,7 +559,7 @@ fn oracle_holds(sequence: &Sequence, start: usize, limit: f32) -> Result<bool> {
         &sequence.cameras,
         &q,
         sequence.free_mask(),
-        TrackerConfig::default(),
+        tracker_config(),
     )
     .map_err(|e| anyhow!("{e}"))?;
     for k in start..start + HELD_FRAMES {
@@ -671,6 +691,9 @@ fn hand_free_run(sequence: &Sequence, args: &Args, csv: &mut Option<std::fs::Fil
 
 fn main() -> Result<()> {
     let args = Args::parse();
+    if let Some(degrees) = args.angle_deg {
+        let _ = TRACKER_ANGLE_DEG.set(degrees);
+    }
     if let Some(dark) = args.blackout.clone() {
         return blackout_sweep(&args, &dark);
     }

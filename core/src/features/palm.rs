@@ -10,8 +10,8 @@
 //! is finger against palm.
 
 use super::{
-    edge_kept, find_edge, EdgePoint, FeatureConfig, LinkFeatures, MIN_WINDOW_SAMPLES,
-    PROBE_BEYOND_EDGE_PX,
+    edge_kept, find_edge, EdgePoint, FeatureConfig, LinkFeatures, RefusedWindows,
+    MIN_WINDOW_SAMPLES, PROBE_BEYOND_EDGE_PX,
 };
 use crate::camera::Camera;
 use crate::config::{MAX_SLICES_PER_LINK, MAX_WINDOW};
@@ -23,13 +23,29 @@ use crate::visibility::{candidates, cover_among, Cover};
 /// Searches the slices across hull edge `edge` of the palm in `view` on `frame`, into `out`:
 /// the edge points found (`side` = the edge's outward side, `s` along it from its first
 /// corner), and the counts of slices expected, masked and off the frame, as a link's.
-#[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
 pub fn find_palm_edge_features(
     view: &ProjectedModel,
     camera: &Camera,
     frame: &FrameView<'_>,
     edge: &HullEdge,
     config: &FeatureConfig,
+    out: &mut LinkFeatures,
+) {
+    let mut refused = RefusedWindows::NONE;
+    find_palm_edge_features_refusing(view, camera, frame, edge, config, &mut refused, out);
+}
+
+/// [`find_palm_edge_features`] across the iterations of one frame, as
+/// [`find_link_features_refusing`](super::find_link_features_refusing) is for a link: the
+/// windows in `refused` stay refused, and windows refused now are added.
+#[inline(never)] // a stage of Table 4.1: kept whole so profiles can attribute its cost
+pub fn find_palm_edge_features_refusing(
+    view: &ProjectedModel,
+    camera: &Camera,
+    frame: &FrameView<'_>,
+    edge: &HullEdge,
+    config: &FeatureConfig,
+    refused: &mut RefusedWindows,
     out: &mut LinkFeatures,
 ) {
     out.edges.clear();
@@ -82,7 +98,11 @@ pub fn find_palm_edge_features(
         }
         out.expected += 1;
         let Some(found) = find_edge(&profile[..window], config.polarity, config.min_contrast)
-            .filter(|e| edge_kept(frame, tangent_limit, start + outward * e.position, outward))
+            .filter(|e| {
+                let at = start + outward * e.position;
+                let bit = RefusedWindows::slice(k, edge.outward);
+                edge_kept(frame, tangent_limit, refused, bit, at, outward)
+            })
         else {
             continue;
         };
