@@ -344,16 +344,7 @@ pub fn find_link_features(
     out: &mut LinkFeatures,
 ) {
     let mut refused = RefusedWindows::NONE;
-    search_link(
-        view,
-        camera,
-        frame,
-        index,
-        config,
-        &mut refused,
-        out,
-        &mut |_| {},
-    );
+    find_link_features_refusing(view, camera, frame, index, config, &mut refused, out);
 }
 
 /// [`find_link_features`] across the iterations of one frame: windows in `refused` (refused
