@@ -82,10 +82,13 @@ const COARSE_POSES: [FingerPose; POSE_COUNT] = [
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct AcquireConfig {
-    /// Work per [`Acquirer::step`] at most, in evaluations: one hypothesis scored in one
-    /// camera counts 1, on the coarse level's cheaper score ([`AcquireConfig::coarse_sampling`])
-    /// [`COARSE_EVALUATION_SHARE`] of one (a slide by [`Acquirer::place`] counts its chamfer
-    /// look-ups over [`LOOKUPS_PER_EVALUATION`]).
+    /// Work per [`Acquirer::step`] at most, in evaluations per camera: one hypothesis scored
+    /// in one camera counts 1, on the coarse level's cheaper score
+    /// ([`AcquireConfig::coarse_sampling`]) [`COARSE_EVALUATION_SHARE`] of one (a slide by
+    /// [`Acquirer::place`] counts its chamfer look-ups over [`LOOKUPS_PER_EVALUATION`]). A
+    /// step with two cameras may spend twice this, so a stereo search scores as many
+    /// hypotheses per frame as a mono one, and a searching frame costs about the same
+    /// multiple of a tracking frame (which also costs twice) in either rig.
     pub evaluations_per_frame: u16,
     /// Depths tried across the volume when the first camera's frame has no bright region.
     pub depths: u8,
@@ -250,6 +253,16 @@ impl Acquirer {
         &self.config
     }
 
+    /// What one [`Acquirer::step`] with `cameras` cameras may spend, in evaluations (at
+    /// least 1): [`AcquireConfig::evaluations_per_frame`] per camera.
+    pub fn budget(&self, cameras: usize) -> u16 {
+        let cameras = cameras.clamp(1, MAX_CAMERAS) as u16;
+        self.config
+            .evaluations_per_frame
+            .max(1)
+            .saturating_mul(cameras)
+    }
+
     /// The working volume.
     pub fn volume(&self) -> &WorkingVolume {
         &self.volume
@@ -287,7 +300,6 @@ impl Acquirer {
         frames: &[FrameView<'_>],
         edges: &[EdgeMap<'_>],
     ) -> Progress {
-        let budget = self.config.evaluations_per_frame.max(1);
         let mut regions: [Option<Region>; MAX_CAMERAS] = [None; MAX_CAMERAS];
         for (r, e) in regions.iter_mut().zip(edges) {
             *r = e.region;
@@ -297,6 +309,7 @@ impl Acquirer {
             .min(frames.len())
             .min(edges.len())
             .min(MAX_CAMERAS);
+        let budget = self.budget(n_cameras);
         let regions = &regions[..n_cameras];
         let mut evaluated = 0u16;
         while evaluated < budget && self.stage != Stage::Done {

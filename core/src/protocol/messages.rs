@@ -386,10 +386,10 @@ pub struct Configure {
     pub features_every: u16,
     /// Send [`BoardMessage::Stats`] every this many frames (0: only when pinged).
     pub stats_every: u16,
-    /// The search's budget per frame, in evaluations, at least 1 (version 4; `acquire`'s
-    /// `AcquireConfig::evaluations_per_frame`; default [`default_search_evaluations`]): a
-    /// searching board answers every frame after at most this much search work (and the one
-    /// hypothesis under way).
+    /// The search's budget per frame and camera, in evaluations, at least 1 (version 4;
+    /// `acquire`'s `AcquireConfig::evaluations_per_frame`; default
+    /// [`default_search_evaluations`]): a searching board answers every frame after at most
+    /// this much search work (and the one hypothesis under way).
     pub search_evaluations_per_frame: u16,
     /// Hypotheses the tracker carries between frames, 1..=[`MAX_HYPOTHESES`] (version 5;
     /// `hypotheses::HypothesesConfig::count`; default [`default_hypotheses`]): 1 is the
