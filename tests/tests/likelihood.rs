@@ -135,3 +135,56 @@ fn the_true_state_scores_better_than_perturbed_ones() {
         cases - worse
     );
 }
+
+/// `evaluate` sums the chamfer term point by point as `likelihood::visit` makes the points,
+/// with no buffer: the same figures, bit for bit, as `Samples::of` and `Samples::chamfer`
+/// over the same points, on the truth and on perturbed states (some points hidden, some
+/// outside the frame).
+#[test]
+fn the_chamfer_summed_as_points_are_made_is_the_buffered_samples() {
+    use digiteyes_core::likelihood::Samples;
+    use digiteyes_core::nalgebra::Vector2;
+    let dir = tempfile::tempdir().unwrap();
+    let config = LikelihoodConfig::default();
+    let mut compared = 0;
+    let mut with_hidden = 0;
+    let mut with_outside = 0;
+    for (scenario, seed) in [("fullhand-mono", 1), ("random-mono", 203)] {
+        let sequence = render(dir.path(), scenario, seed, 1);
+        let truth = sequence.read_truth().unwrap();
+        let q: Vec<f32> = truth.rows[0].iter().map(|&v| v as f32).collect();
+        let image = sequence.read_frame(0, 0).unwrap();
+        let (w, h) = (image.width() as usize, image.height() as usize);
+        let frame = FrameView::packed(image.as_raw(), w, h).unwrap();
+        let mut buffer = vec![0u8; EdgeMap::bytes_needed(w, h, config.stride_px)];
+        let edges = EdgeMap::build(&mut buffer, &frame, &config).unwrap();
+        let camera = &sequence.cameras[0];
+        for (dx, angle, bend) in [(0.0, 0.0, 0.0), (40.0, 0.5, 0.6), (-400.0, 0.0, -0.2)] {
+            let p = perturbed(&q, dx, angle, bend);
+            let poses = Poses::compute(&sequence.model, &p).unwrap();
+            let mut view = ProjectedModel::new();
+            view.update(&sequence.model, &poses, camera, 4.0);
+            let streamed = evaluate(&view, camera, &frame, &edges, &config);
+            let samples = Samples::of(&view, camera, &config);
+            let (chamfer, inside) =
+                samples.chamfer(&edges, Vector2::zeros(), config.chamfer_cap_px);
+            let label = format!("{scenario} {seed} ({dx}, {angle}, {bend})");
+            assert_eq!(streamed.points_hidden, samples.hidden, "{label}");
+            assert_eq!(streamed.points, inside, "{label}");
+            assert_eq!(
+                streamed.points_outside as usize,
+                samples.points.len() - usize::from(inside),
+                "{label}"
+            );
+            if inside > 0 {
+                assert_eq!(streamed.chamfer_px.to_bits(), chamfer.to_bits(), "{label}");
+            }
+            compared += 1;
+            with_hidden += usize::from(samples.hidden > 0);
+            with_outside += usize::from(streamed.points_outside > 0);
+        }
+    }
+    assert_eq!(compared, 6);
+    assert!(with_hidden > 0, "no view had hidden points");
+    assert!(with_outside > 0, "no view had points outside the frame");
+}

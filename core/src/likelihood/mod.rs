@@ -13,7 +13,6 @@ use core::fmt;
 
 use crate::camera::Camera;
 use crate::frame::FrameView;
-use crate::nalgebra::Vector2;
 use crate::projection::ProjectedModel;
 
 mod edges;
@@ -23,7 +22,7 @@ mod state;
 
 pub use edges::{EdgeMap, EDGE_BINS, GRADIENT_STEP_PX};
 pub use region::{Region, EXTENT_PERCENTILE, MAX_EXTENT_BINS, MIN_REGION_SAMPLES};
-pub use samples::{Samples, SilhouettePoint, MAX_SAMPLES, MAX_SAMPLES_PER_LINE};
+pub use samples::{visit, Samples, SilhouettePoint, MAX_SAMPLES, MAX_SAMPLES_PER_LINE};
 pub use state::{mean_score, StateScorer, MIN_LINK_PX};
 
 /// Parameters of the edge map and of the score.
@@ -115,15 +114,33 @@ pub fn evaluate(
     edges: &EdgeMap<'_>,
     config: &LikelihoodConfig,
 ) -> Likelihood {
-    let samples = Samples::of(view, camera, config);
     let cap = config.chamfer_cap_px.max(1e-3);
-    let (chamfer_px, inside) = samples.chamfer(edges, Vector2::zeros(), cap);
-    let outside = (samples.points.len() as u16).saturating_sub(inside);
+    // The chamfer term of each visible silhouette point as it is visited: no buffer of points
+    // (`Samples::chamfer`'s sum, in the same order).
+    let (mut sum, mut points, mut inside) = (0.0f32, 0u32, 0u16);
+    let hidden = samples::visit(view, camera, config, |p| {
+        points += 1;
+        match edges.distance_px(usize::from(p.bin), &p.at) {
+            Some(d) => {
+                sum += d.min(cap);
+                inside = inside.saturating_add(1);
+            }
+            None => sum += cap,
+        }
+    });
+    let chamfer_px = if points == 0 {
+        cap
+    } else {
+        sum / points as f32
+    };
+    let outside = u16::try_from(points)
+        .unwrap_or(u16::MAX)
+        .saturating_sub(inside);
     if inside == 0 {
         return Likelihood {
             chamfer_px: cap,
             points_outside: outside,
-            points_hidden: samples.hidden,
+            points_hidden: hidden,
             ..Likelihood::default()
         };
     }
@@ -141,7 +158,7 @@ pub fn evaluate(
         chamfer_px,
         points: inside,
         points_outside: outside,
-        points_hidden: samples.hidden,
+        points_hidden: hidden,
         silhouette,
         score,
     }
@@ -150,6 +167,7 @@ pub fn evaluate(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::nalgebra::Vector2;
 
     #[test]
     fn a_small_buffer_or_a_zero_stride_is_an_error() {

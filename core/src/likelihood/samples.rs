@@ -40,41 +40,12 @@ impl Samples {
     /// The visible silhouette points of `view` (camera `camera`):
     /// [`LikelihoodConfig::samples_per_line`] along each side of each link.
     pub fn of(view: &ProjectedModel, camera: &Camera, config: &LikelihoodConfig) -> Self {
-        let mut out = Samples::default();
-        let n = usize::from(config.samples_per_line).clamp(1, MAX_SAMPLES_PER_LINE);
-        for (index, link) in view.links.iter().enumerate() {
-            let d = link.b - link.a;
-            let len = d.norm();
-            if len < 1e-3 {
-                continue;
-            }
-            let dir = d / len;
-            let normal = Vector2::new(-dir.y, dir.x);
-            let (bin, _) = bin_of(libm::atan2f(normal.y, normal.x));
-            // The parts that can hide any of this link's points, found once for the link (its
-            // bounds hold every silhouette point): the same verdicts as per point, cheaper.
-            let (among, palm) = candidates(view, index, &link.bounds);
-            for (side, sign) in [(0usize, 1.0f32), (1, -1.0)] {
-                for i in 0..n {
-                    let s = (i as f32 + 0.5) / n as f32;
-                    let r = link.r0[side] + s * (link.r1[side] - link.r0[side]);
-                    let p = link.a + d * s + normal * (sign * r);
-                    if cover_among(view, camera, &among, palm, &p, link.depth_at(s))
-                        == Cover::Hidden
-                    {
-                        // A nearer part of the hand hides this line: no edge is expected.
-                        out.hidden = out.hidden.saturating_add(1);
-                        continue;
-                    }
-                    // Bounded by MAX_SAMPLES: cannot overflow.
-                    let _ = out.points.push(SilhouettePoint {
-                        at: p,
-                        bin: bin as u8,
-                    });
-                }
-            }
-        }
-        out
+        let mut points = Vec::new();
+        let hidden = visit(view, camera, config, |p| {
+            // Bounded by MAX_SAMPLES: cannot overflow.
+            let _ = points.push(p);
+        });
+        Samples { points, hidden }
     }
 
     /// The mean truncated chamfer distance (px) of the points shifted by `offset` (px) to
@@ -96,4 +67,47 @@ impl Samples {
             (sum / self.points.len() as f32, inside)
         }
     }
+}
+
+/// Calls `visible` with each visible silhouette point of `view` (camera `camera`), in
+/// [`Samples::of`]'s order, and returns how many were hidden by a nearer part of the hand:
+/// the points without a buffer to hold them (at most [`MAX_SAMPLES`]).
+pub fn visit(
+    view: &ProjectedModel,
+    camera: &Camera,
+    config: &LikelihoodConfig,
+    mut visible: impl FnMut(SilhouettePoint),
+) -> u16 {
+    let mut hidden = 0u16;
+    let n = usize::from(config.samples_per_line).clamp(1, MAX_SAMPLES_PER_LINE);
+    for (index, link) in view.links.iter().enumerate() {
+        let d = link.b - link.a;
+        let len = d.norm();
+        if len < 1e-3 {
+            continue;
+        }
+        let dir = d / len;
+        let normal = Vector2::new(-dir.y, dir.x);
+        let (bin, _) = bin_of(libm::atan2f(normal.y, normal.x));
+        // The parts that can hide any of this link's points, found once for the link (its
+        // bounds hold every silhouette point): the same verdicts as per point, cheaper.
+        let (among, palm) = candidates(view, index, &link.bounds);
+        for (side, sign) in [(0usize, 1.0f32), (1, -1.0)] {
+            for i in 0..n {
+                let s = (i as f32 + 0.5) / n as f32;
+                let r = link.r0[side] + s * (link.r1[side] - link.r0[side]);
+                let p = link.a + d * s + normal * (sign * r);
+                if cover_among(view, camera, &among, palm, &p, link.depth_at(s)) == Cover::Hidden {
+                    // A nearer part of the hand hides this line: no edge is expected.
+                    hidden = hidden.saturating_add(1);
+                    continue;
+                }
+                visible(SilhouettePoint {
+                    at: p,
+                    bin: bin as u8,
+                });
+            }
+        }
+    }
+    hidden
 }
