@@ -22,6 +22,7 @@ mod state;
 
 pub use edges::{EdgeMap, EDGE_BINS, GRADIENT_STEP_PX};
 pub use region::{Region, EXTENT_PERCENTILE, MAX_EXTENT_BINS, MIN_REGION_SAMPLES};
+use samples::ChamferSum;
 pub use samples::{visit, Samples, SilhouettePoint, MAX_SAMPLES, MAX_SAMPLES_PER_LINE};
 pub use state::{mean_score, StateScorer, MIN_LINK_PX};
 
@@ -117,25 +118,9 @@ pub fn evaluate(
     let cap = config.chamfer_cap_px.max(1e-3);
     // The chamfer term of each visible silhouette point as it is visited: no buffer of points
     // (`Samples::chamfer`'s sum, in the same order).
-    let (mut sum, mut points, mut inside) = (0.0f32, 0u32, 0u16);
-    let hidden = samples::visit(view, camera, config, |p| {
-        points += 1;
-        match edges.distance_px(usize::from(p.bin), &p.at) {
-            Some(d) => {
-                sum += d.min(cap);
-                inside = inside.saturating_add(1);
-            }
-            None => sum += cap,
-        }
-    });
-    let chamfer_px = if points == 0 {
-        cap
-    } else {
-        sum / points as f32
-    };
-    let outside = u16::try_from(points)
-        .unwrap_or(u16::MAX)
-        .saturating_sub(inside);
+    let mut chamfer = ChamferSum::new(cap);
+    let hidden = samples::visit(view, camera, config, |p| chamfer.add(edges, p.bin, &p.at));
+    let (chamfer_px, inside, outside) = (chamfer.mean_px(), chamfer.inside, chamfer.outside());
     if inside == 0 {
         return Likelihood {
             chamfer_px: cap,

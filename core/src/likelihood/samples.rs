@@ -51,21 +51,63 @@ impl Samples {
     /// The mean truncated chamfer distance (px) of the points shifted by `offset` (px) to
     /// like-oriented edges, and how many fell inside the frame; points outside cost `cap_px`.
     pub fn chamfer(&self, edges: &EdgeMap<'_>, offset: Vector2<f32>, cap_px: f32) -> (f32, u16) {
-        let (mut sum, mut inside) = (0.0f32, 0u16);
+        let mut sum = ChamferSum::new(cap_px);
         for p in &self.points {
-            match edges.distance_px(usize::from(p.bin), &(p.at + offset)) {
-                Some(d) => {
-                    sum += d.min(cap_px);
-                    inside = inside.saturating_add(1);
-                }
-                None => sum += cap_px,
+            sum.add(edges, p.bin, &(p.at + offset));
+        }
+        (sum.mean_px(), sum.inside)
+    }
+}
+
+/// The chamfer term summed point by point: each point's distance (px) to the nearest edge of
+/// its orientation bin, truncated at the cap; a point outside the frame costs the cap.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ChamferSum {
+    cap_px: f32,
+    sum_px: f32,
+    /// Points added.
+    pub(crate) points: u32,
+    /// Points added that fell inside the frame.
+    pub(crate) inside: u16,
+}
+
+impl ChamferSum {
+    pub(crate) fn new(cap_px: f32) -> Self {
+        ChamferSum {
+            cap_px,
+            sum_px: 0.0,
+            points: 0,
+            inside: 0,
+        }
+    }
+
+    /// Adds the point at `at` (px) of orientation bin `bin`.
+    #[inline]
+    pub(crate) fn add(&mut self, edges: &EdgeMap<'_>, bin: u8, at: &Vector2<f32>) {
+        self.points += 1;
+        match edges.distance_px(usize::from(bin), at) {
+            Some(d) => {
+                self.sum_px += d.min(self.cap_px);
+                self.inside = self.inside.saturating_add(1);
             }
+            None => self.sum_px += self.cap_px,
         }
-        if self.points.is_empty() {
-            (cap_px, 0)
+    }
+
+    /// The mean truncated distance (px); the cap when no point was added.
+    pub(crate) fn mean_px(&self) -> f32 {
+        if self.points == 0 {
+            self.cap_px
         } else {
-            (sum / self.points.len() as f32, inside)
+            self.sum_px / self.points as f32
         }
+    }
+
+    /// Points added that fell outside the frame.
+    pub(crate) fn outside(&self) -> u16 {
+        u16::try_from(self.points)
+            .unwrap_or(u16::MAX)
+            .saturating_sub(self.inside)
     }
 }
 
