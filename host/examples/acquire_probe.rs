@@ -36,7 +36,7 @@ use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::Robust;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::likelihood::EdgeMap;
+use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig, StateScorer};
 use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::scenarios::{render_scenario, RenderOptions};
@@ -255,6 +255,44 @@ struct Run {
     refined: u32,
 }
 
+/// Finer likelihoods than the search's, for the leaves CSV: (stride, cap, samples per line,
+/// silhouette grid).
+const FINE: [(u8, f32, u8, u8); 4] = [
+    (2, 12.0, 12, 16),
+    (4, 24.0, 6, 48),
+    (1, 8.0, 12, 48),
+    (2, 8.0, 12, 48),
+];
+
+/// `q` scored under each of [`FINE`]: ",mean,worst" per config.
+fn fine_columns(sequence: &Sequence, views: &[FrameView<'_>], q: &[f32]) -> Result<String> {
+    let mut out = String::new();
+    let mut scorer = StateScorer::new();
+    for &(stride, cap, per_line, grid) in &FINE {
+        let config = LikelihoodConfig {
+            stride_px: stride,
+            chamfer_cap_px: cap,
+            samples_per_line: per_line,
+            silhouette_grid: grid,
+            ..LikelihoodConfig::default()
+        };
+        let mut bufs: Vec<Vec<u8>> = sequence
+            .cameras
+            .iter()
+            .map(|c| vec![0u8; EdgeMap::bytes_needed(c.width as usize, c.height as usize, stride)])
+            .collect();
+        let maps: Vec<EdgeMap<'_>> = bufs
+            .iter_mut()
+            .zip(views)
+            .map(|(b, v)| EdgeMap::build(b, v, &config).map_err(|e| anyhow!("{e}")))
+            .collect::<Result<_>>()?;
+        let (mean, worst) =
+            scorer.score_cameras(&sequence.model, &sequence.cameras, views, &maps, q, &config);
+        out.push_str(&format!(",{mean:.4},{worst:.4}"));
+    }
+    Ok(out)
+}
+
 /// Edge maps of `views` in `buffers`.
 fn edge_maps<'b>(
     buffers: &'b mut [Vec<u8>],
@@ -406,9 +444,15 @@ fn run(
             if let (Some((verdict, q)), Some(f)) = (auto.finder().last_leaf(), csv.as_mut()) {
                 let n = sequence.n_states();
                 let e = tip_error_px(&sequence.model, &sequence.cameras, &q[..n], &truth_k);
+                let images = read_frames(sequence, k)?;
+                let views: Vec<_> = images
+                    .iter()
+                    .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
+                    .collect::<Result<_, _>>()?;
+                let fine = fine_columns(sequence, &views, &q[..n])?;
                 writeln!(
                     f,
-                    "{label},{k},{:.4},{:.4},{},{},{e:.2}",
+                    "{label},{k},{:.4},{:.4},{},{},{e:.2}{fine}",
                     verdict.score,
                     verdict.worst_camera,
                     u8::from(verdict.lost),
@@ -474,11 +518,29 @@ fn blackout_run(
         searching: 0,
     };
     let mut line = String::new();
+    let mut errors = String::new();
     for k in 0..sequence.frames {
         let truth_k: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
         let was = auto.status();
         let (report, claimed, e) = step_frame(sequence, &mut auto, &mut bufs, k, &truth_k)?;
         line.push(status_char(&report, was));
+        if k + 4 >= dark.start && k < dark.start || k >= dark.end && k < dark.end + 12 {
+            errors.push_str(&format!(" {k}:{e:.1}"));
+        }
+        if args.verbose && (k + 1 == dark.start || k == dark.end + 10) {
+            let st = auto.state();
+            let d: Vec<String> = (0..st.len())
+                .map(|i| {
+                    let x = st[i] - truth_k[i];
+                    if (4..7).contains(&i) {
+                        format!("{x:.0}")
+                    } else {
+                        format!("{x:.2}")
+                    }
+                })
+                .collect();
+            eprintln!("{label}: frame {k} state - truth: {}", d.join(" "));
+        }
         if dark.contains(&k) && claimed {
             out.dark_claimed += 1;
         }
@@ -497,6 +559,7 @@ fn blackout_run(
         .map(|k| k - dark.end);
     if args.verbose {
         eprintln!("{label}: {line}");
+        eprintln!("{label}: tip px{errors}");
     }
     Ok(out)
 }
@@ -668,12 +731,13 @@ fn hand_free_run(sequence: &Sequence, args: &Args, csv: &mut Option<std::fs::Fil
             finder
                 .step(&mut tracker, &views, &maps)
                 .map_err(|e| anyhow!("{e}"))?;
-            if let Some((verdict, _)) = finder.last_leaf() {
+            if let Some((verdict, q)) = finder.last_leaf() {
                 worst = worst.max(verdict.score);
                 if let Some(f) = csv.as_mut() {
+                    let fine = fine_columns(sequence, &views, &q[..sequence.n_states()])?;
                     writeln!(
                         f,
-                        "hand-free-{kind}-{},{k},{:.4},{:.4},{},0,inf",
+                        "hand-free-{kind}-{},{k},{:.4},{:.4},{},0,inf{fine}",
                         sequence.cameras.len(),
                         verdict.score,
                         verdict.worst_camera,
@@ -702,7 +766,7 @@ fn main() -> Result<()> {
     let mut csv = match &args.leaves_csv {
         Some(p) => {
             let mut f = std::fs::File::create(p)?;
-            writeln!(f, "run,frame,score,worst_camera,lost,accepted,tip_error_px")?;
+            writeln!(f, "run,frame,score,worst_camera,lost,accepted,tip_error_px,f1,f1w,f2,f2w,f3,f3w,f4,f4w")?;
             Some(f)
         }
         None => None,

@@ -94,6 +94,7 @@ fn the_benchmark_runs_a_tiny_sweep() {
         json: Some(dir.path().join("sweep.json")),
         keep: None,
         gallery: Some(dir.path().join("gallery")),
+        fixed_light: false,
     };
     let sweep = run(&args).unwrap();
     assert!(sweep.failed.is_empty(), "{:?}", sweep.failed);
@@ -154,6 +155,7 @@ fn a_small_sweep_holds_the_hand_better_than_the_plain_loop() {
             json: None,
             keep: None,
             gallery: None,
+            fixed_light: false,
         })
         .unwrap()
     };
@@ -178,5 +180,69 @@ fn a_small_sweep_holds_the_hand_better_than_the_plain_loop() {
         "median joint RMS {:.1}° (default) vs {:.1}° (plain)",
         median(&default),
         median(&plain)
+    );
+}
+
+/// The sweep's lighting varies from seed to seed across its ranges, keeps the hand's darkest
+/// shade above the plain background, and changes nothing else of a seed: the same rig, motion,
+/// noise and blur as under the fixed light (`--fixed-light`).
+#[test]
+fn random_lighting_varies_by_seed_and_leaves_the_rig_and_motion_alone() {
+    use digiteyes_host::render::{Lighting, PLAIN_GREY};
+    let (mut ambient, mut albedo, mut angle) = (Vec::new(), Vec::new(), Vec::new());
+    for seed in 1..=40u64 {
+        let name = if seed.is_multiple_of(2) {
+            "random-stereo"
+        } else {
+            "random-mono"
+        };
+        let own = generate(name, &options(seed)).unwrap();
+        let fixed = generate(
+            name,
+            &RenderOptions {
+                lighting: Some(Lighting::default()),
+                ..options(seed)
+            },
+        )
+        .unwrap();
+        assert_eq!(own.truth, fixed.truth, "seed {seed}: the motion changed");
+        assert_eq!(
+            own.file.cameras, fixed.file.cameras,
+            "seed {seed}: the rig changed"
+        );
+        assert_eq!(own.settings.noise_sigma, fixed.settings.noise_sigma);
+        assert_eq!(own.settings.blur_sigma, fixed.settings.blur_sigma);
+        assert_eq!(fixed.settings.lighting, Lighting::default());
+        let l = own.settings.lighting;
+        assert_ne!(l, Lighting::default(), "seed {seed}: its own light");
+        assert!(
+            l.darkest() > f64::from(PLAIN_GREY) + 10.0,
+            "seed {seed}: the hand's darkest shade {} is near the background's",
+            l.darkest()
+        );
+        let v = l.unit_toward_light();
+        ambient.push(l.ambient);
+        albedo.push(l.albedo);
+        angle.push((-v.z).acos().to_degrees());
+    }
+    let span = |v: &[f64]| {
+        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        (lo, hi)
+    };
+    let (a0, a1) = span(&ambient);
+    assert!(
+        (0.25..0.3).contains(&a0) && a1 > 0.45 && a1 <= 0.5,
+        "ambient {a0}..{a1}"
+    );
+    let (b0, b1) = span(&albedo);
+    assert!(
+        (150.0..165.0).contains(&b0) && b1 > 215.0 && b1 <= 230.0,
+        "albedo {b0}..{b1}"
+    );
+    let (g0, g1) = span(&angle);
+    assert!(
+        (5.0..15.0).contains(&g0) && g1 > 50.0 && g1 <= 60.0,
+        "angle {g0}..{g1} deg"
     );
 }

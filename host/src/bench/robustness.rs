@@ -14,6 +14,7 @@ use digiteyes_core::state::TRANSLATION;
 use serde::Serialize;
 
 use crate::eval::{evaluate, stats, EvalReport};
+use crate::render::Lighting;
 use crate::scenarios::{render_scenario, RenderOptions};
 use crate::sequence::states::read_states_with_gaps;
 use crate::sequence::Sequence;
@@ -91,6 +92,11 @@ pub struct RobustnessArgs {
     /// (DIR/seedNNNN-frameNNNN-camN.png, the colours of docs/overlay.md).
     #[arg(long, value_name = "DIR")]
     pub gallery: Option<PathBuf>,
+    /// Light every seed with the one fixed light the sweep used before its lighting was
+    /// varied (albedo 200, ambient 0.35), to reproduce figures marked "fixed light" in
+    /// docs/robustness.md.
+    #[arg(long)]
+    pub fixed_light: bool,
 }
 
 /// One seed's figures.
@@ -167,6 +173,7 @@ pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResu
         frames: Some(args.frames),
         size: Some(args.size),
         supersample: 2,
+        lighting: args.fixed_light.then(Lighting::default),
         ..RenderOptions::default()
     };
     render_scenario(name, &seq, &options).with_context(|| format!("seed {seed}"))?;
@@ -289,6 +296,7 @@ pub fn run(args: &RobustnessArgs) -> Result<Sweep> {
         motion: args.motion,
         frames: args.frames,
         size: args.size,
+        fixed_light: args.fixed_light,
         seeds,
         failed,
     };
@@ -308,6 +316,8 @@ pub struct Sweep {
     pub frames: usize,
     /// Image size (px).
     pub size: (u32, u32),
+    /// Every seed lit by the fixed light (`--fixed-light`), not its own.
+    pub fixed_light: bool,
     /// Every seed tracked.
     pub seeds: Vec<SeedResult>,
     /// Seeds that could not be rendered or tracked, and why.

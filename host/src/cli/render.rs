@@ -8,6 +8,7 @@ use clap::Args;
 use digiteyes_platform_linux::parse_frame_size;
 
 use crate::cli_values;
+use crate::render::Lighting;
 use crate::scenarios::{render_scenario, RenderOptions, DEFAULT_FRAMES, NAMES, RANDOM_NAMES};
 
 /// Render a synthetic scenario to a sequence folder.
@@ -35,8 +36,9 @@ use crate::scenarios::{render_scenario, RenderOptions, DEFAULT_FRAMES, NAMES, RA
 ///   clutter          the mouse motion over a cluttered background, noise σ 8
 ///   random-mono      a random rig from --seed: one camera anywhere on the upper
 ///                    hemisphere (elevation 20-90°, any azimuth, 350-1500 mm, hand
-///                    120-350 px wide) and a random whole-hand motion through fists,
-///                    crossing fingers and end-on fingers (docs/robustness.md)
+///                    120-350 px wide), a random whole-hand motion through fists,
+///                    crossing fingers and end-on fingers, and random lighting (a light
+///                    5-60° off the camera's axis, ambient 0.25-0.5; docs/robustness.md)
 ///   random-stereo    the same with a second camera 150-600 mm beside the first
 ///   thesis-stereo    the thesis' stereo rig: two cameras behind the wrist, 60° up
 #[derive(Args, Debug)]
@@ -49,7 +51,7 @@ pub struct RenderArgs {
     pub scenario: String,
     /// Output sequence folder (created if missing; existing files are overwritten).
     pub outdir: PathBuf,
-    /// Seed of the motion, noise and clutter.
+    /// Seed of the motion, noise and clutter (and of the random scenarios' rig and lighting).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Number of frames (1 to 100000).
@@ -65,6 +67,10 @@ pub struct RenderArgs {
     /// Cluttered, textured background (default: only for `clutter`).
     #[arg(long)]
     pub clutter: bool,
+    /// Light the hand with the built-in scenarios' fixed light (albedo 200, ambient 0.35,
+    /// 31° up-left of the camera's axis) instead of a random scenario's own.
+    #[arg(long)]
+    pub fixed_light: bool,
     /// Image size in px, e.g. 320x240 (default 640x480); the view stays the same.
     #[arg(long, value_name = "WxH", value_parser = parse_frame_size)]
     pub size: Option<(u32, u32)>,
@@ -104,6 +110,7 @@ pub fn run(args: RenderArgs, progress: bool) -> Result<()> {
         noise: args.noise,
         blur: args.blur,
         clutter: args.clutter.then_some(true),
+        lighting: args.fixed_light.then(Lighting::default),
         size: args.size,
         supersample: args.supersample,
         progress,

@@ -2,7 +2,7 @@
 //!
 //! Every pixel is ray-cast against the capsules of the `cyl` links and the palm box (exact
 //! occlusion: the nearest hit wins), shaded Lambertian with a light near the camera plus
-//! ambient, over a dark or cluttered background. Each pixel averages `supersample ×
+//! ambient ([`Lighting`]), over a dark or cluttered background. Each pixel averages `supersample ×
 //! supersample` rays spread evenly over its square (pixel `(x, y)` covers `u ∈ [x − ½, x + ½]`,
 //! `v ∈ [y − ½, y + ½]`), so silhouettes are sub-pixel accurate. Optional Gaussian blur and
 //! noise follow. Rays are cast only inside each primitive's projected bounding rectangle, and
@@ -11,6 +11,7 @@
 pub mod background;
 pub mod filter;
 pub mod intersect;
+pub mod lighting;
 pub mod scene;
 pub mod shapes;
 
@@ -23,15 +24,9 @@ use image::GrayImage;
 use nalgebra::Vector3;
 
 pub use background::{Background, PLAIN_GREY};
+pub use lighting::{Lighting, ALBEDO, AMBIENT, LIGHT};
 pub use scene::Scene;
 pub use shapes::{world_shapes, WorldShape};
-
-/// The hand's albedo: its grey level (0–255) when lit face-on.
-pub const ALBEDO: f64 = 200.0;
-/// Fraction of the albedo seen on surfaces facing away from the light.
-pub const AMBIENT: f64 = 0.35;
-/// Direction towards the light, camera coordinates (up-left of the camera), unnormalised.
-pub const LIGHT: [f64; 3] = [-0.35, -0.5, -1.0];
 
 /// How frames are rendered (besides the hand's state and the camera).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,6 +39,8 @@ pub struct RenderSettings {
     pub blur_sigma: f32,
     /// What lies behind the hand.
     pub background: Background,
+    /// How the hand is lit.
+    pub lighting: Lighting,
     /// Worker threads; 0 uses every available core.
     pub threads: usize,
 }
@@ -55,6 +52,7 @@ impl Default for RenderSettings {
             noise_sigma: 0.0,
             blur_sigma: 0.0,
             background: Background::default(),
+            lighting: Lighting::default(),
             threads: 0,
         }
     }
@@ -145,7 +143,12 @@ impl Renderer {
             n => n,
         }
         .min(h.div_ceil(ROWS_PER_JOB));
-        let raster = Raster::new(&self.camera, self.settings.supersample, mode);
+        let raster = Raster::new(
+            &self.camera,
+            self.settings.supersample,
+            self.settings.lighting,
+            mode,
+        );
         std::thread::scope(|s| {
             for _ in 0..threads {
                 s.spawn(|| {
@@ -174,12 +177,14 @@ struct Raster {
     fy: f64,
     /// Sub-pixel offsets of the rays along each axis (px).
     offsets: Vec<f64>,
+    lighting: Lighting,
+    /// Unit vector towards the light.
     light: Vector3<f64>,
     mode: Mode,
 }
 
 impl Raster {
-    fn new(camera: &Camera, supersample: u32, mode: Mode) -> Self {
+    fn new(camera: &Camera, supersample: u32, lighting: Lighting, mode: Mode) -> Self {
         let n = supersample.max(1);
         Raster {
             cx: f64::from(camera.cx),
@@ -189,7 +194,8 @@ impl Raster {
             offsets: (0..n)
                 .map(|i| (f64::from(i) + 0.5) / f64::from(n) - 0.5)
                 .collect(),
-            light: Vector3::from(LIGHT).normalize(),
+            lighting,
+            light: lighting.unit_toward_light(),
             mode,
         }
     }
@@ -240,10 +246,7 @@ impl Raster {
                     let d = Vector3::new((u - self.cx) / self.fx, (v - self.cy) / self.fy, 1.0)
                         .normalize();
                     sum += match (scene.nearest(&d, candidates), self.mode) {
-                        (Some(hit), Mode::Shaded) => {
-                            ALBEDO
-                                * (AMBIENT + (1.0 - AMBIENT) * hit.normal.dot(&self.light).max(0.0))
-                        }
+                        (Some(hit), Mode::Shaded) => self.lighting.shade(&hit.normal, &self.light),
                         (Some(_), Mode::Coverage) => 1.0,
                         (None, _) => behind,
                     };

@@ -12,6 +12,7 @@ use anyhow::{bail, Result};
 
 use super::cameras::look_at;
 use super::mouse_thesis;
+use crate::render::Lighting;
 use crate::sequence::CameraFile;
 
 /// Every scenario name, in the order `--help` lists them.
@@ -53,6 +54,8 @@ pub struct Scenario {
     pub blur: f32,
     /// Whether the background is cluttered.
     pub clutter: bool,
+    /// How the hand is lit.
+    pub lighting: Lighting,
 }
 
 /// The fixture's camera: 45° above the table, looking at the hand.
@@ -189,6 +192,7 @@ fn mouse(name: &'static str, summary: &'static str, speed: f64) -> Scenario {
         noise: 2.0,
         blur: 0.5,
         clutter: false,
+        lighting: Lighting::default(),
     }
 }
 
@@ -211,6 +215,7 @@ fn fullhand(name: &'static str, summary: &'static str, cameras: Vec<CameraFile>)
         noise: 2.0,
         blur: 0.5,
         clutter: false,
+        lighting: Lighting::default(),
     }
 }
 
@@ -234,6 +239,7 @@ pub fn scenario(name: &str) -> Result<Scenario> {
             noise: 2.0,
             blur: 0.5,
             clutter: false,
+            lighting: Lighting::default(),
         },
         "fast" => mouse(
             "fast",
@@ -261,6 +267,7 @@ pub fn scenario(name: &str) -> Result<Scenario> {
             noise: 2.0,
             blur: 0.5,
             clutter: false,
+            lighting: Lighting::default(),
         },
         "twofinger" => {
             let mut base = table_pose();
@@ -291,6 +298,7 @@ pub fn scenario(name: &str) -> Result<Scenario> {
                 noise: 2.0,
                 blur: 0.5,
                 clutter: false,
+                lighting: Lighting::default(),
             }
         }
         "fullhand-stereo" => fullhand(

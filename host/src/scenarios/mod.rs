@@ -22,7 +22,7 @@ use anyhow::{bail, ensure, Context, Result};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::model::Model;
 
-use crate::render::{Background, RenderSettings, Renderer};
+use crate::render::{Background, Lighting, RenderSettings, Renderer};
 use crate::sequence::{self, CameraFile, SequenceFile, BUILTIN_HAND};
 pub use catalogue::{scenario, Scenario, NAMES};
 pub use random::RANDOM_NAMES;
@@ -55,6 +55,9 @@ pub struct RenderOptions {
     pub blur: Option<f32>,
     /// Cluttered background.
     pub clutter: Option<bool>,
+    /// The hand's lighting; `None` for the scenario's own (drawn from the seed for the random
+    /// scenarios, [`Lighting::default`] for the others).
+    pub lighting: Option<Lighting>,
     /// Image size (px); the intrinsics scale so the view is the same.
     pub size: Option<(u32, u32)>,
     /// Rays per pixel along each axis.
@@ -78,6 +81,7 @@ impl Default for RenderOptions {
             noise: None,
             blur: None,
             clutter: None,
+            lighting: None,
             size: None,
             supersample: 3,
             progress: false,
@@ -200,6 +204,7 @@ pub fn generate_from(scenario: Scenario, opts: &RenderOptions) -> Result<Generat
         } else {
             Background::default()
         },
+        lighting: opts.lighting.unwrap_or(scenario.lighting),
         threads: 0,
     };
     Ok(Generated {

@@ -12,13 +12,17 @@
 //!   fingers seen end-on as they curl toward a camera), the palm turning up to ±40° about its
 //!   axes and moving up to ±60 mm;
 //! - noise (σ 1–6 grey levels), blur (σ 0.3–1.2 px) and the fingertips' peak speed
-//!   (3–8 px/frame). The renderer's lighting is fixed; it is not varied.
+//!   (3–8 px/frame);
+//! - the lighting: a light beside the camera 5–60° off its axis, ambient 0.25–0.5 of an
+//!   albedo of 150–230 grey levels (drawn after everything above, so a seed's rig, motion,
+//!   noise and blur are those it had when the lighting was fixed).
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::cameras::{look_at, resized};
 use super::catalogue::Scenario;
+use crate::render::Lighting;
 use crate::sequence::CameraFile;
 
 /// Names of the scenarios of this module.
@@ -124,6 +128,18 @@ fn camera_at(
     camera
 }
 
+/// A light beside the camera, 5–60° off its axis in any image direction; ambient 0.25–0.5 of
+/// an albedo of 150–230 grey levels. The hand's darkest shade (37.5 at least) stays above the
+/// plain background's grey, as the tracker's region evidence assumes of every rig it is
+/// built for.
+fn random_lighting(rng: &mut ChaCha8Rng) -> Lighting {
+    let angle = rng.random_range(5.0..60.0) * DEG;
+    let azimuth = rng.random_range(0.0..360.0) * DEG;
+    let ambient = rng.random_range(0.25..0.5);
+    let albedo = rng.random_range(150.0..230.0);
+    Lighting::beside_camera(albedo, ambient, angle, azimuth)
+}
+
 /// The random scenario of `seed`, with one camera or two.
 pub fn random_scenario(seed: u64, stereo: bool) -> Scenario {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x005e_ed0f_4a4d_u64);
@@ -185,6 +201,9 @@ pub fn random_scenario(seed: u64, stereo: bool) -> Scenario {
         noise: rng.random_range(1.0..6.0),
         blur: rng.random_range(0.3..1.2),
         clutter: false,
+        // Drawn last, so the rig, the motion, the noise and the blur of a seed are those it
+        // had before the lighting was varied.
+        lighting: random_lighting(&mut rng),
     }
 }
 
@@ -218,6 +237,7 @@ pub fn thesis_stereo() -> Scenario {
         noise: 2.0,
         blur: 0.5,
         clutter: false,
+        lighting: Lighting::default(),
     }
 }
 
