@@ -524,7 +524,9 @@ fn blackout_run(
         let was = auto.status();
         let (report, claimed, e) = step_frame(sequence, &mut auto, &mut bufs, k, &truth_k)?;
         line.push(status_char(&report, was));
-        if k + 4 >= dark.start && k < dark.start || k >= dark.end && k < dark.end + 12 {
+        if args.verbose
+            && (k + 4 >= dark.start && k < dark.start || k >= dark.end && k < dark.end + 12)
+        {
             errors.push_str(&format!(" {k}:{e:.1}"));
         }
         if args.verbose && (k + 1 == dark.start || k == dark.end + 10) {

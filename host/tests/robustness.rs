@@ -16,6 +16,15 @@ fn options(seed: u64) -> RenderOptions {
     }
 }
 
+/// The sweep's rig for `seed`: two cameras for even seeds, one for odd ones.
+fn sweep_rig(seed: u64) -> &'static str {
+    if seed.is_multiple_of(2) {
+        "random-stereo"
+    } else {
+        "random-mono"
+    }
+}
+
 /// Camera `c`'s centre in the world (mm): `−Rᵀ t`.
 fn eye(file: &digiteyes_host::sequence::CameraFile) -> [f64; 3] {
     let (r, t) = (file.r, file.t);
@@ -27,11 +36,7 @@ fn random_rigs_are_seeded_in_view_within_limits_and_cover_the_hemisphere() {
     let model = Model::hand().unwrap();
     let (mut elevations, mut quadrants, mut distances) = (Vec::new(), [false; 4], Vec::new());
     for seed in 1..=40u64 {
-        let name = if seed.is_multiple_of(2) {
-            "random-stereo"
-        } else {
-            "random-mono"
-        };
+        let name = sweep_rig(seed);
         let a = generate(name, &options(seed)).unwrap();
         let b = generate(name, &options(seed)).unwrap();
         assert_eq!(a.truth, b.truth, "seed {seed} not deterministic");
@@ -191,11 +196,7 @@ fn random_lighting_varies_by_seed_and_leaves_the_rig_and_motion_alone() {
     use digiteyes_host::render::{Lighting, PLAIN_GREY};
     let (mut ambient, mut albedo, mut angle) = (Vec::new(), Vec::new(), Vec::new());
     for seed in 1..=40u64 {
-        let name = if seed.is_multiple_of(2) {
-            "random-stereo"
-        } else {
-            "random-mono"
-        };
+        let name = sweep_rig(seed);
         let own = generate(name, &options(seed)).unwrap();
         let fixed = generate(
             name,

@@ -93,8 +93,8 @@ pub struct RobustnessArgs {
     #[arg(long, value_name = "DIR")]
     pub gallery: Option<PathBuf>,
     /// Light every seed with the one fixed light the sweep used before its lighting was
-    /// varied (albedo 200, ambient 0.35), to reproduce figures marked "fixed light" in
-    /// docs/robustness.md.
+    /// varied (albedo 200, ambient 0.35), to reproduce the figures docs/robustness.md
+    /// measured under it.
     #[arg(long)]
     pub fixed_light: bool,
 }
