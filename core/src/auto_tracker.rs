@@ -16,11 +16,16 @@
 //!   (unless [`Recovery::Never`]: then it stays `Lost`, as the plain tracker does).
 //! - **Searching after a loss** first tries a *local re-acquisition* for
 //!   [`LOCAL_SEARCH_FRAMES`] frames (the hand does not go far while it is hidden for a second
-//!   or two): each frame, the last good state is slid over each camera's edge map within
-//!   [`LOCAL_WINDOW`] of the frame's width of where it projects ([`Acquirer::place`]), each
-//!   placed state refined by the tracker's Gauss–Newton ([`LOCAL_REFINE_PASSES`] passes on the
-//!   frame), and the best taken for the hand if the search's acceptance test takes it. The work per frame is bounded: one slide and
-//!   [`LOCAL_REFINE_PASSES`] tracker passes per camera. Only then does the global search run.
+//!   or two): each frame, a variant of the last good state is slid over the first camera's
+//!   edge map within [`LOCAL_WINDOW`] of the frame's width of where it projects
+//!   ([`Acquirer::place`]) and placed on the bright regions ([`Acquirer::replace`]), its palm
+//!   is given the library's finger pose that scores best ([`Acquirer::best_pose`]), and the
+//!   last frame's best is followed; at most [`FinderConfig::local_starts`] of these are
+//!   refined by the tracker's Gauss–Newton ([`LOCAL_REFINE_PASSES`] passes on the frame), and
+//!   the best taken for the hand if the search's acceptance test takes it. The work per frame
+//!   is bounded: one slide, one placement, the library's poses scored once, and
+//!   `local_starts` × [`LOCAL_REFINE_PASSES`] tracker passes. Only then does the global
+//!   search run.
 //! - While searching, [`AutoTracker::state`] holds the last state that claimed the hand (the
 //!   base state before the first acquisition), never a refused hypothesis.
 //!
@@ -155,6 +160,20 @@ struct Refined {
     worst_camera: f32,
     q: [f32; MAX_STATES],
     report: FrameReport,
+}
+
+/// Where a start of the local re-acquisition comes from.
+#[derive(Clone, Copy)]
+enum LocalStart {
+    /// The best refined start of the last frame.
+    Followed,
+    /// The last good palm with the library's best finger pose
+    /// ([`FinderConfig::local_library_pose`]).
+    Library,
+    /// The variant slid over the first camera's edge map ([`Acquirer::place`]).
+    Slid,
+    /// The variant placed on the bright regions ([`Acquirer::replace`]).
+    Placed,
 }
 
 /// The pixels of the largest camera's frames.
@@ -344,6 +363,7 @@ impl AutoTracker {
     }
 
     /// A tracking or lost frame: the tracker runs, the status follows its `lost` flag.
+    #[inline(never)] // a stage of the status machine: kept whole so profiles can attribute its cost
     fn follow(
         &mut self,
         frames: &[FrameView<'_>],
@@ -518,12 +538,15 @@ impl AutoTracker {
         Ok(())
     }
 
-    /// One frame of local re-acquisition: a variant of the last good state (itself on every
-    /// other frame, else turned or moved in depth: [`Acquirer::variant`]) slid over the first
-    /// camera's edge map near where it projects and placed on the frame's bright regions,
-    /// and the hypothesis followed from the last frame (if any), each refined by Gauss–Newton
+    /// One frame of local re-acquisition: the hypothesis followed from the last frame (if
+    /// any), the last good palm under the library's best-scoring finger pose
+    /// ([`FinderConfig::local_library_pose`]), and a variant of the last good state (itself on
+    /// every other frame, else turned or moved in depth: [`Acquirer::variant`]) slid over the
+    /// first camera's edge map near where it projects or placed on the frame's bright
+    /// regions; the first [`FinderConfig::local_starts`] of these are refined by Gauss–Newton
     /// and scored over every camera; the best is accepted if the acceptance test takes it,
     /// else followed to the next frame if it reaches [`LOCAL_FOLLOW_SCORE`].
+    #[inline(never)] // a stage of the status machine: kept whole so profiles can attribute its cost
     fn local_search(
         &mut self,
         frames: &[FrameView<'_>],
@@ -550,11 +573,58 @@ impl AutoTracker {
             )
         };
         let followed = self.following.take();
-        let mut refined: Vec<Refined, 3> = Vec::new();
-        for start in 0..3 {
+        let replaced = {
+            let tracker = self.multi.tracker();
+            let cameras = tracker.cameras();
+            let mut q = seed;
+            self.finder
+                .acquirer_mut()
+                .replace(
+                    tracker.model(),
+                    &cameras[..cameras.len().min(MAX_CAMERAS)],
+                    maps,
+                    &mut q,
+                )
+                .then_some(q)
+        };
+        let library = if self.finder.config().local_library_pose {
+            let tracker = self.multi.tracker();
+            let palm = replaced.unwrap_or(seed);
+            let (q, _) = self.finder.acquirer_mut().best_pose(
+                tracker.model(),
+                tracker.cameras(),
+                frames,
+                maps,
+                &palm,
+            );
+            Some(q)
+        } else {
+            None
+        };
+        let order = if frame.is_multiple_of(2) {
+            [
+                LocalStart::Followed,
+                LocalStart::Library,
+                LocalStart::Slid,
+                LocalStart::Placed,
+            ]
+        } else {
+            [
+                LocalStart::Followed,
+                LocalStart::Library,
+                LocalStart::Placed,
+                LocalStart::Slid,
+            ]
+        };
+        let most = usize::from(self.finder.config().local_starts);
+        let mut refined: Vec<Refined, 4> = Vec::new();
+        for start in order {
+            if refined.len() >= most {
+                break;
+            }
             let tracker = self.multi.tracker();
             let q = match start {
-                0 => match (maps.first(), tracker.cameras().first().copied()) {
+                LocalStart::Slid => match (maps.first(), tracker.cameras().first().copied()) {
                     (Some(map), Some(camera)) => {
                         let near_px = camera.width as f32 * LOCAL_WINDOW;
                         self.finder
@@ -564,18 +634,9 @@ impl AutoTracker {
                     }
                     _ => None,
                 },
-                1 => {
-                    let mut q = seed;
-                    let cameras = tracker.cameras();
-                    let placed = self.finder.acquirer_mut().replace(
-                        tracker.model(),
-                        &cameras[..cameras.len().min(MAX_CAMERAS)],
-                        maps,
-                        &mut q,
-                    );
-                    placed.then_some(q)
-                }
-                _ => followed,
+                LocalStart::Placed => replaced,
+                LocalStart::Followed => followed,
+                LocalStart::Library => library,
             };
             let Some(q) = q else { continue };
             let r = self.refine(frames, maps, q, n)?;
@@ -656,6 +717,7 @@ impl AutoTracker {
     }
 
     /// A searching frame: the search moves on, or some of its leaves are refined and judged.
+    #[inline(never)] // a stage of the status machine: kept whole so profiles can attribute its cost
     fn search(
         &mut self,
         frames: &[FrameView<'_>],

@@ -5,7 +5,7 @@
 //! normal equations `JᵀWJ` and `JᵀWr` ([`add_link_rows`]; a full `J` is never stored). The
 //! step is `Δ = −(JᵀWJ + S)⁻¹ JᵀWr` with the constant diagonal conditioning matrix `S`, solved
 //! by a sparse `LDLᵀ` factorisation over the free states ([`NormalEquations::step`]); only the
-//! free states change. [`reference`] builds the same rows one at a time, the plain way: it is
+//! free states change. [`reference`](mod@reference) builds the same rows one at a time, the plain way: it is
 //! the oracle the tests hold the tracker's path to.
 //!
 //! Residual kinds, each "predicted minus measured", in pixels ([`ResidualKind`]):
@@ -23,7 +23,7 @@
 //!
 //! Modules: `config` (the parameters), `jacobian` ([`LinkJacobian`]), `normal`
 //! ([`NormalEquations`] and the solve), `link_rows` (the tracker's per-link blocks),
-//! `palm_rows` (the palm outline's, through the same blocks) and [`reference`] (the oracle
+//! `palm_rows` (the palm outline's, through the same blocks) and [`reference`](mod@reference) (the oracle
 //! rows).
 
 use nalgebra::SVector;

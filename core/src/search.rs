@@ -97,9 +97,9 @@ impl CameraSearch {
     }
 
     /// Searches the palm's hull edge `edge` of `view` on `frame` into `out`
-    /// ([`find_palm_edge_features`]), narrowing the window with `refine` as
-    /// [`CameraSearch::link`] does, by what the last search of the edge between the same two
-    /// box corners needed. Returns the edge points found.
+    /// ([`find_palm_edge_features`](crate::features::find_palm_edge_features)), narrowing
+    /// the window with `refine` as [`CameraSearch::link`] does, by what the last search of the
+    /// edge between the same two box corners needed. Returns the edge points found.
     #[allow(clippy::too_many_arguments)]
     pub fn palm_edge(
         &mut self,

@@ -87,6 +87,12 @@ struct Args {
     passes: Option<u8>,
     #[arg(long)]
     min_score: Option<f32>,
+    /// The local re-acquisition also starts from the library's best finger pose (true/false).
+    #[arg(long)]
+    local_library: Option<bool>,
+    /// Starts refined per local re-acquisition frame, at most.
+    #[arg(long)]
+    local_starts: Option<u8>,
     /// Re-place leaves on the frame they are refined on (true/false).
     #[arg(long)]
     replace: Option<bool>,
@@ -189,6 +195,8 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         leaf_max_edge_angle_rad: args
             .leaf_angle_deg
             .map_or(f.leaf_max_edge_angle_rad, f32::to_radians),
+        local_library_pose: args.local_library.unwrap_or(f.local_library_pose),
+        local_starts: args.local_starts.unwrap_or(f.local_starts),
     };
     (acquire, finder)
 }

@@ -4,14 +4,14 @@
 //! and, from no initial state, the status machine acquires the hand on random rigs the sweep
 //! says it acquires (docs/recovery.md: `acquire_probe --seeds 101..=140`).
 
-use digiteyes_core::acquire::{AcquireConfig, Finder, FinderConfig, FinderStep, Progress};
+use digiteyes_core::acquire::{
+    AcquireConfig, Finder, FinderConfig, FinderStep, FingerPose, Progress, POSE_COUNT,
+};
 use digiteyes_core::auto_tracker::Status;
-use digiteyes_core::camera::Camera;
+use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::{FreeMask, Robust};
 use digiteyes_core::frame::FrameView;
-use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::EdgeMap;
-use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::{render_scenario, RenderOptions, TrackerConfig};
@@ -247,28 +247,6 @@ fn the_search_keeps_its_budget_and_goes_on_where_it_left_off() {
     }
 }
 
-/// Mean fingertip distance (px) between states `a` and `b` over every camera.
-fn tip_error_px(model: &Model, cameras: &[Camera], a: &[f32], b: &[f32]) -> f32 {
-    let (pa, pb) = (
-        Poses::compute(model, a).unwrap(),
-        Poses::compute(model, b).unwrap(),
-    );
-    let tips =
-        (0..model.links().len()).filter(|&i| matches!(model.links()[i].shape, Shape::Tip { .. }));
-    let (mut sum, mut n) = (0.0f32, 0);
-    for t in tips {
-        for c in cameras {
-            let (x, y) = (pa.origin(t).unwrap(), pb.origin(t).unwrap());
-            sum += match (c.project(&x), c.project(&y)) {
-                (Some(u), Some(v)) => (u - v).norm(),
-                _ => 1e3,
-            };
-            n += 1;
-        }
-    }
-    sum / n as f32
-}
-
 /// `rig` at `seed` (34 frames, 320×240) searched from nothing by the status machine under
 /// `tracker`: per frame, whether a hand was claimed within 5 px of the truth, and the line
 /// `y` (claimed, right) / `n` (claimed, wrong) / `.` (none).
@@ -291,8 +269,8 @@ fn acquisition(
         let r = auto.step(&views, &mut b).unwrap();
         let claimed = r.status == Status::Tracking && !r.report.lost;
         let t: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
-        let ok =
-            claimed && tip_error_px(&sequence.model, &sequence.cameras, auto.state(), &t) <= 5.0;
+        let ok = claimed
+            && search::tip_error_px(&sequence.model, &sequence.cameras, auto.state(), &t) <= 5.0;
         line.push(if ok {
             'y'
         } else if claimed {
@@ -402,5 +380,65 @@ fn leaves_are_refined_without_the_trackers_edge_direction_test() {
     assert!(
         acquired_before(&good, 30).is_none(),
         "random-stereo 803 acquired with leaves under the tracker's edge test: {line}"
+    );
+}
+
+#[test]
+fn the_library_pose_that_scores_best_is_the_nearest_the_hand() {
+    // `Acquirer::best_pose` (the local re-acquisition's extra start) chooses among the
+    // library's finger poses by the likelihood. Under the true palm on `fullhand-stereo`'s
+    // first frame (a relaxed, slightly spread hand), started from a fist, it keeps the palm,
+    // scores best of all the poses, and is nearer the true fingers than most of them. (Not
+    // the nearest: the likelihood scores the open hand 0.909 here, the relaxed one, nearest
+    // the truth, 0.877; the fist and the pointing hand score lowest. Gauss-Newton refines
+    // the chosen start before the acceptance judges it.)
+    let dir = tempfile::tempdir().unwrap();
+    let sequence = render(dir.path(), "fullhand-stereo", 0, 1);
+    let n = sequence.n_states();
+    let truth: Vec<f32> = sequence.read_truth().unwrap().rows[0]
+        .iter()
+        .map(|&v| v as f32)
+        .collect();
+    let acquire = AcquireConfig::default();
+    let mut acquirer = search::acquirer(&sequence, acquire);
+    let images = frames::images(&sequence, 0);
+    let views = frames::views(&images);
+    let mut bufs = search::buffers(&sequence.cameras, acquire.likelihood.stride_px);
+    let maps: Vec<EdgeMap<'_>> = bufs
+        .iter_mut()
+        .zip(&views)
+        .map(|(b, f)| EdgeMap::build(b, f, &acquire.likelihood).unwrap())
+        .collect();
+    let mut q = [0.0f32; MAX_STATES];
+    q[..n].copy_from_slice(&truth);
+    let fist = acquirer.with_pose(&q, FingerPose::Fist as usize);
+    let (chosen, score) =
+        acquirer.best_pose(&sequence.model, &sequence.cameras, &views, &maps, &fist);
+    assert_eq!(chosen[..7], truth[..7], "the palm is kept");
+    let distance = |p: &[f32; MAX_STATES]| -> f32 {
+        (7..n)
+            .map(|i| (p[i] - truth[i]).powi(2))
+            .sum::<f32>()
+            .sqrt()
+    };
+    let poses: Vec<[f32; MAX_STATES]> =
+        (0..POSE_COUNT).map(|p| acquirer.with_pose(&q, p)).collect();
+    for (p, posed) in poses.iter().enumerate() {
+        let s = acquirer.score(&sequence.model, &sequence.cameras, &views, &maps, posed);
+        println!(
+            "pose {p}: {:.2} rad from the fingers, score {s:.3}",
+            distance(posed)
+        );
+        assert!(s <= score, "pose {p} scores {s} over the chosen {score}");
+    }
+    let mut distances: Vec<f32> = poses.iter().map(&distance).collect();
+    distances.sort_by(f32::total_cmp);
+    let median = distances[POSE_COUNT / 2];
+    assert!(
+        distance(&chosen) < median && distance(&chosen) < distance(&fist),
+        "chose a pose {:.2} rad from the fingers; the library's median is {median:.2}, the \
+         fist {:.2}",
+        distance(&chosen),
+        distance(&fist)
     );
 }

@@ -53,6 +53,14 @@ pub struct FinderConfig {
     /// rad, π/2: off): a leaf starts turned from the hand, where the image's edges run at an
     /// angle to the predicted ones and the test would refuse the edges that pull it in.
     pub leaf_max_edge_angle_rad: f32,
+    /// The local re-acquisition after a loss also starts from the last good palm with the
+    /// library's finger pose that scores best on the frame: the hand's fingers move on while
+    /// it is hidden, and Gauss–Newton from the old ones can settle on a wrong pose.
+    pub local_library_pose: bool,
+    /// Starts refined per frame of local re-acquisition, at most (each costs
+    /// `LOCAL_REFINE_PASSES` tracker passes): the followed one and the library's first, then
+    /// the slid and the placed variant, these two in turn when not all fit.
+    pub local_starts: u8,
 }
 
 impl Default for FinderConfig {
@@ -69,6 +77,8 @@ impl Default for FinderConfig {
             confirm_min_score: 0.0,
             leaf_robust: Robust::Huber(2.0),
             leaf_max_edge_angle_rad: core::f32::consts::FRAC_PI_2,
+            local_library_pose: true,
+            local_starts: 3,
         }
     }
 }

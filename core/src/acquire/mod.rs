@@ -412,6 +412,35 @@ impl Acquirer {
         out
     }
 
+    /// `q` with its free finger states set to library pose `pose` (taken modulo
+    /// [`POSE_COUNT`]); its palm and fixed states kept.
+    pub fn with_pose(&self, q: &[f32; MAX_STATES], pose: usize) -> [f32; MAX_STATES] {
+        let mut out = *q;
+        set_fingers(&mut out, pose % POSE_COUNT, self.n_states, self.free);
+        out
+    }
+
+    /// The library pose under `q`'s palm that scores best on this frame (mean over the
+    /// cameras), with its score: [`POSE_COUNT`] evaluations in every camera.
+    pub fn best_pose(
+        &mut self,
+        model: &Model,
+        cameras: &[Camera],
+        frames: &[FrameView<'_>],
+        edges: &[EdgeMap<'_>],
+        q: &[f32; MAX_STATES],
+    ) -> ([f32; MAX_STATES], f32) {
+        let mut best = (*q, f32::NEG_INFINITY);
+        for pose in 0..POSE_COUNT {
+            let posed = self.with_pose(q, pose);
+            let score = self.score(model, cameras, frames, edges, &posed);
+            if score > best.1 {
+                best = (posed, score);
+            }
+        }
+        best
+    }
+
     /// Moves the palm of `q` onto this frame's bright regions (`edges`' regions), its depth
     /// kept in one camera and triangulated in two ([`place`]): a leaf found on an earlier
     /// frame put where the hand is now. False (and `q` unchanged) when it cannot be placed

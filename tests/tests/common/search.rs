@@ -5,7 +5,9 @@ use digiteyes_core::acquire::{AcquireConfig, Acquirer, WorkingVolume};
 use digiteyes_core::auto_tracker::AutoTracker;
 use digiteyes_core::camera::Camera;
 use digiteyes_core::estimator::FreeMask;
+use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::EdgeMap;
+use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::tracker::TrackerConfig;
 use digiteyes_host::sequence::Sequence;
 
@@ -63,4 +65,26 @@ pub fn buffers(cameras: &[Camera], stride_px: u8) -> Vec<Vec<u8>> {
         .iter()
         .map(|c| vec![0u8; EdgeMap::bytes_needed(c.width as usize, c.height as usize, stride_px)])
         .collect()
+}
+
+/// Mean fingertip distance (px) between states `a` and `b` over every camera.
+pub fn tip_error_px(model: &Model, cameras: &[Camera], a: &[f32], b: &[f32]) -> f32 {
+    let (pa, pb) = (
+        Poses::compute(model, a).unwrap(),
+        Poses::compute(model, b).unwrap(),
+    );
+    let tips =
+        (0..model.links().len()).filter(|&i| matches!(model.links()[i].shape, Shape::Tip { .. }));
+    let (mut sum, mut n) = (0.0f32, 0);
+    for t in tips {
+        for c in cameras {
+            let (x, y) = (pa.origin(t).unwrap(), pb.origin(t).unwrap());
+            sum += match (c.project(&x), c.project(&y)) {
+                (Some(u), Some(v)) => (u - v).norm(),
+                _ => 1e3,
+            };
+            n += 1;
+        }
+    }
+    sum / n as f32
 }
