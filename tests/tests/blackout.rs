@@ -310,8 +310,8 @@ fn the_local_reacquisition_tries_the_librarys_finger_poses_under_the_last_good_p
     // re-acquisition also starts from the last good palm under the library's finger pose the
     // likelihood scores best (`FinderConfig::local_library_pose`). `random-stereo` 1014 is
     // re-acquired only with it. (A seed that shows the mechanism, not a sweep's verdict:
-    // over fresh seeds 1011-1090, of the 53 tracked up to the blackout, 44 are re-acquired
-    // with it and 37 without; docs/recovery.md.)
+    // over fresh seeds 1011-1170, of the 103 tracked up to the blackout, 84 are
+    // re-acquired with it and 76 without; docs/recovery.md.)
     let dir = tempfile::tempdir().unwrap();
     let with = FinderConfig::default();
     assert!(with.local_library_pose, "on by default");
