@@ -25,7 +25,8 @@
 //!   the best taken for the hand if the search's acceptance test takes it. The work per frame
 //!   is bounded: one slide, one placement, the library's poses scored once, and
 //!   `local_starts` × [`LOCAL_REFINE_PASSES`] tracker passes. Only then does the global
-//!   search run.
+//!   search run — or sooner, once [`FinderConfig::local_frames_in_view`] local frames have
+//!   refined a start (the hand is back in view) without accepting any.
 //! - While searching, [`AutoTracker::state`] holds the last state that claimed the hand (the
 //!   base state before the first acquisition), never a refused hypothesis.
 //!
@@ -55,8 +56,9 @@ use crate::watch::{Watch, WatchConfig};
 /// Lost frames in a row after which the tracker gives the hand up and searches again.
 pub const LOST_FRAMES_BEFORE_SEARCH: u32 = 10;
 
-/// Searching frames after a loss spent on the local re-acquisition before the global search:
-/// two seconds at 30 frames/s, after the [`LOST_FRAMES_BEFORE_SEARCH`] lost frames.
+/// Searching frames after a loss spent on the local re-acquisition before the global search,
+/// at most: two seconds at 30 frames/s, after the [`LOST_FRAMES_BEFORE_SEARCH`] lost frames
+/// (fewer when the hand is back in view and not taken: [`FinderConfig::local_frames_in_view`]).
 pub const LOCAL_SEARCH_FRAMES: u32 = 60;
 
 /// Half the side of the window the local re-acquisition slides the last good state over, as a
@@ -201,6 +203,9 @@ pub struct AutoTracker {
     /// The best refined local hypothesis of the last frame, when it scored at least
     /// [`LOCAL_FOLLOW_SCORE`]: refined again on the next.
     following: Option<[f32; MAX_STATES]>,
+    /// Local re-acquisition frames since the loss on which a start was refined without being
+    /// lost (the hand is back in view) but none was accepted.
+    local_in_view: u32,
     recovery: Recovery,
     /// The image's check on the track.
     watch: Watch,
@@ -243,6 +248,7 @@ impl AutoTracker {
             ever_tracked: false,
             local_left: 0,
             following: None,
+            local_in_view: 0,
             recovery: Recovery::Search,
             watch: Watch::new(WatchConfig::default(), largest_frame_pixels(cameras)),
             vouched: heapless::Vec::new(),
@@ -429,6 +435,7 @@ impl AutoTracker {
                 self.following = None;
                 self.confirm_left = 0;
                 self.multi.set_config(self.hypotheses);
+                self.local_in_view = 0;
                 self.local_left = if self.ever_tracked {
                     LOCAL_SEARCH_FRAMES
                 } else {
@@ -666,8 +673,18 @@ impl AutoTracker {
                 lost: false,
                 ..report
             };
-        } else if score >= LOCAL_FOLLOW_SCORE {
-            self.following = Some(q);
+        } else {
+            if score >= LOCAL_FOLLOW_SCORE {
+                self.following = Some(q);
+            }
+            if score > 0.0 {
+                self.local_in_view = self.local_in_view.saturating_add(1);
+                let most = u32::from(finder.local_frames_in_view);
+                if most > 0 && self.local_in_view >= most {
+                    self.local_left = 0;
+                    self.following = None;
+                }
+            }
         }
         Ok(())
     }

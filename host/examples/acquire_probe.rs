@@ -90,6 +90,9 @@ struct Args {
     /// The local re-acquisition also starts from the library's best finger pose (true/false).
     #[arg(long)]
     local_library: Option<bool>,
+    /// Local frames with the hand's region found before the global search (0: all 60).
+    #[arg(long)]
+    local_in_view: Option<u8>,
     /// Starts refined per local re-acquisition frame, at most.
     #[arg(long)]
     local_starts: Option<u8>,
@@ -197,6 +200,7 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             .map_or(f.leaf_max_edge_angle_rad, f32::to_radians),
         local_library_pose: args.local_library.unwrap_or(f.local_library_pose),
         local_starts: args.local_starts.unwrap_or(f.local_starts),
+        local_frames_in_view: args.local_in_view.unwrap_or(f.local_frames_in_view),
     };
     (acquire, finder)
 }

@@ -61,6 +61,11 @@ pub struct FinderConfig {
     /// `LOCAL_REFINE_PASSES` tracker passes): the followed one and the library's first, then
     /// the slid and the placed variant, these two in turn when not all fit.
     pub local_starts: u8,
+    /// The local re-acquisition gives way to the global search after this many of its frames
+    /// refined a start that Gauss–Newton did not lose (the hand is back in view) without
+    /// accepting any (0: only after all its frames): a hand back in view that it cannot take
+    /// has turned or moved farther than its variants reach.
+    pub local_frames_in_view: u8,
 }
 
 impl Default for FinderConfig {
@@ -79,6 +84,7 @@ impl Default for FinderConfig {
             leaf_max_edge_angle_rad: core::f32::consts::FRAC_PI_2,
             local_library_pose: true,
             local_starts: 3,
+            local_frames_in_view: 8,
         }
     }
 }
