@@ -5,6 +5,8 @@
 //! - a stream of valid messages with bytes corrupted at random: every message whose frame (and
 //!   both delimiters around it) was untouched decodes exactly as sent — the decoder is back in
 //!   step at the first clean frame — and no corrupted frame is ever taken for a message;
+//! - a decoder joining a stream of valid frames at any byte (a host opening a board's port)
+//!   decodes every frame that arrives whole and reports no error for the cut one;
 //! - random host messages round-trip;
 //! - random `Hypotheses` (version 5: up to 8 hypotheses of up to 32 states, any floats) fit
 //!   `MAX_MESSAGE`, round-trip, and decode from a stream cut into random pieces.
@@ -209,6 +211,60 @@ proptest! {
         for c in &clean {
             prop_assert!(it.any(|g| g == c), "a clean frame was lost");
         }
+    }
+
+    #[test]
+    fn joining_a_stream_anywhere_loses_no_whole_frame_and_reports_no_error(
+        tokens in prop::collection::vec(any::<u32>(), 2..12),
+        cut_share in 0.0f64..1.0,
+        piece in 1usize..64,
+    ) {
+        // A host opening a board's port discards what arrived before, which can cut a frame
+        // anywhere. The mid-stream decoder drops the tail without an error and decodes every
+        // frame that arrives whole, even one whose leading delimiter was cut off; the plain
+        // decoder counts such a tail as an error.
+        let frames: Vec<Vec<u8>> = tokens.iter().map(|&t| frame_of(&HostMessage::Ping(t))).collect();
+        let stream: Vec<u8> = frames.concat();
+        let cut = ((stream.len() as f64) * cut_share) as usize;
+        let feed_all = |rx: &mut Rx| {
+            let mut got = Vec::new();
+            for chunk in stream[cut..].chunks(piece) {
+                let mut rest = chunk;
+                while !rest.is_empty() {
+                    let (used, out) = rx.feed::<HostMessage>(rest);
+                    if let Some(Ok(m)) = out {
+                        got.push(frame_of(&m));
+                    }
+                    rest = &rest[used..];
+                }
+            }
+            got
+        };
+        // The frames whose body (all but the leading delimiter) is after the cut.
+        let mut start = 0;
+        let mut whole = Vec::new();
+        for f in &frames {
+            if start + 1 >= cut {
+                whole.push(f.clone());
+            }
+            start += f.len();
+        }
+        let mut rx = Rx::mid_stream();
+        let got = feed_all(&mut rx);
+        prop_assert_eq!(&got, &whole);
+        let c = rx.counters();
+        prop_assert_eq!(c.crc_errors + c.framing_errors + c.decode_errors + c.overflows, 0);
+        let mut start = 0;
+        let inside = frames.iter().any(|f| {
+            let body = start + 1..start + f.len() - 1;
+            start += f.len();
+            body.contains(&cut) && cut > body.start
+        });
+        prop_assert_eq!(rx.joined_mid_frame(), u32::from(inside));
+        let mut plain = Rx::new();
+        let _ = feed_all(&mut plain);
+        let c = plain.counters();
+        prop_assert_eq!(c.crc_errors + c.framing_errors, u32::from(inside));
     }
 
     #[test]

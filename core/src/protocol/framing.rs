@@ -75,12 +75,20 @@ pub fn max_encoded_len<T: Serialize + ?Sized>(message: &T) -> Option<usize> {
 ///
 /// Garbage between frames is discarded at the next delimiter and counted; a corrupted frame
 /// costs that frame only, so the stream resynchronises by the next one.
+///
+/// A decoder that joins a stream already flowing ([`Decoder::mid_stream`]: a host opening a
+/// board's serial port, which discards what arrived before) may first see the tail of a
+/// frame. Its first frame, when it is not a message, is dropped and counted in
+/// [`Decoder::joined_mid_frame`], not as an error of the link.
 #[derive(Debug, Clone)]
 pub struct Decoder<const N: usize> {
     buf: [u8; N],
     len: usize,
     overflowed: bool,
     counters: LinkCounters,
+    /// No delimiter seen yet by a decoder that joined the stream mid-way.
+    joining: bool,
+    joined_mid_frame: u32,
 }
 
 impl<const N: usize> Default for Decoder<N> {
@@ -103,7 +111,23 @@ impl<const N: usize> Decoder<N> {
                 decode_errors: 0,
                 overflows: 0,
             },
+            joining: false,
+            joined_mid_frame: 0,
         }
+    }
+
+    /// An empty decoder for a stream that may already be flowing: a first frame that is not
+    /// a message is the tail of one sent before this end listened, and is dropped without
+    /// counting as an error ([`Decoder::joined_mid_frame`]).
+    pub const fn mid_stream() -> Self {
+        let mut decoder = Self::new();
+        decoder.joining = true;
+        decoder
+    }
+
+    /// First frames dropped as the tail of a frame sent before this end listened (0 or 1).
+    pub fn joined_mid_frame(&self) -> u32 {
+        self.joined_mid_frame
     }
 
     /// What this decoder has seen so far.
@@ -137,35 +161,55 @@ impl<const N: usize> Decoder<N> {
                 continue;
             }
             let len = core::mem::replace(&mut self.len, 0);
+            let joining = core::mem::replace(&mut self.joining, false);
             if core::mem::replace(&mut self.overflowed, false) {
+                if joining {
+                    self.joined_mid_frame += 1;
+                    return (i + 1, None);
+                }
                 self.counters.overflows += 1;
                 return (i + 1, Some(Err(LinkError::Overflow)));
             }
             if len == 0 {
                 continue;
             }
-            return (i + 1, Some(self.decode(len)));
+            let body = match self.unframe(len) {
+                Ok(body) => body,
+                Err(_) if joining => {
+                    self.joined_mid_frame += 1;
+                    return (i + 1, None);
+                }
+                Err(e) => {
+                    match e {
+                        LinkError::Framing => self.counters.framing_errors += 1,
+                        _ => self.counters.crc_errors += 1,
+                    }
+                    return (i + 1, Some(Err(e)));
+                }
+            };
+            return (i + 1, Some(self.parse(body)));
         }
         (input.len(), None)
     }
 
-    fn decode<'d, T: Deserialize<'d>>(&'d mut self, len: usize) -> Result<T, LinkError> {
+    /// Undoes the COBS of the `len` bytes received and checks the CRC; returns the length of
+    /// the body before the CRC (nothing counted here).
+    fn unframe(&mut self, len: usize) -> Result<usize, LinkError> {
         let frame = self.buf.get_mut(..len).unwrap_or_default();
-        let Ok(n) = cobs::decode_in_place(frame) else {
-            self.counters.framing_errors += 1;
-            return Err(LinkError::Framing);
-        };
+        let n = cobs::decode_in_place(frame).map_err(|_| LinkError::Framing)?;
         // The CRC is checked before decoding, so a corrupted frame counts as a CRC error
         // whatever its bytes happen to decode as.
         let payload = self.buf.get(..n).unwrap_or_default();
-        let Some((body, crc)) = payload.split_last_chunk::<4>() else {
-            self.counters.crc_errors += 1;
-            return Err(LinkError::Crc);
-        };
+        let (body, crc) = payload.split_last_chunk::<4>().ok_or(LinkError::Crc)?;
         if CRC.checksum(body) != u32::from_le_bytes(*crc) {
-            self.counters.crc_errors += 1;
             return Err(LinkError::Crc);
         }
+        Ok(body.len())
+    }
+
+    /// The message in the first `len` bytes of the unframed body.
+    fn parse<'d, T: Deserialize<'d>>(&'d mut self, len: usize) -> Result<T, LinkError> {
+        let body = self.buf.get(..len).unwrap_or_default();
         match postcard::take_from_bytes(body) {
             Ok((message, [])) => {
                 self.counters.messages += 1;

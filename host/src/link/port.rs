@@ -28,13 +28,15 @@ pub struct Link {
 
 impl Link {
     /// Opens the serial device at `path` (raw, 8N1, `baud` bits/s) and discards anything
-    /// the board sent before. Fails naming the path when it is missing or cannot be opened.
+    /// the board sent before; the discard can cut a frame the board was sending, whose tail
+    /// is then dropped without counting as an error ([`Link::joined_mid_frame`]). Fails
+    /// naming the path when it is missing or cannot be opened.
     pub fn open(path: &str, baud: u32) -> Result<Link> {
         let port = TtySerial::open(path, baud)?;
         Ok(Link {
             port,
             path: path.to_string(),
-            rx: Decoder::new(),
+            rx: Decoder::mid_stream(),
             inbox: VecDeque::new(),
             bytes_up: 0,
             bytes_down: 0,
@@ -129,6 +131,12 @@ impl Link {
         self.rx.counters()
     }
 
+    /// Frame tails dropped on opening the port: the end of a frame the board was sending
+    /// when the port's pending input was discarded (0 or 1).
+    pub fn joined_mid_frame(&self) -> u32 {
+        self.rx.joined_mid_frame()
+    }
+
     fn read_some(&mut self, wait: Duration) -> Result<()> {
         let mut buf = [0u8; 4096];
         let n = self
@@ -145,5 +153,45 @@ impl Link {
             input = &input[used..];
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serialport::{SerialPort, TTYPort};
+    use std::io::Write;
+
+    /// Opening the port discards what arrived before, which can cut the frame the board was
+    /// sending (its boot `Hello`, say): the tail that follows is dropped and reported apart,
+    /// not counted as a framing or CRC error, and the next frame decodes.
+    #[test]
+    fn the_tail_of_a_frame_cut_by_opening_the_port_is_dropped_without_an_error() {
+        let (mut board, slave) = TTYPort::pair().unwrap();
+        let mut link = Link::open(&slave.name().unwrap(), 115_200).unwrap();
+        let mut buf = [0u8; MAX_MESSAGE];
+        let cut = encode(&BoardMessage::Pong(3), &mut buf).unwrap().to_vec();
+        let mut buf = [0u8; MAX_MESSAGE];
+        let whole = encode(&BoardMessage::Pong(4), &mut buf).unwrap().to_vec();
+        board.write_all(&cut[cut.len() / 2..]).unwrap();
+        board.write_all(&whole).unwrap();
+        board.flush().unwrap();
+        let got = link.recv(Duration::from_secs(10)).unwrap();
+        assert_eq!(got, Some(BoardMessage::Pong(4)));
+        let c = link.counters();
+        assert_eq!((c.messages, c.crc_errors, c.framing_errors), (1, 0, 0));
+        assert_eq!(link.joined_mid_frame(), 1);
+        // Later garbage is an error as ever.
+        board.write_all(&cut[cut.len() / 2..]).unwrap();
+        board.write_all(&whole).unwrap();
+        board.flush().unwrap();
+        assert_eq!(
+            link.recv(Duration::from_secs(10)).unwrap(),
+            Some(BoardMessage::Pong(4))
+        );
+        let c = link.counters();
+        assert_eq!(c.messages, 2);
+        assert_eq!(c.crc_errors + c.framing_errors, 1);
+        assert_eq!(link.joined_mid_frame(), 1);
     }
 }

@@ -42,6 +42,9 @@ pub struct LinkReport {
     pub bytes_down: u64,
     /// The host's decoder: messages, CRC and framing errors.
     pub host_link: LinkCounters,
+    /// The tail of a frame the board was sending when the host opened the port, dropped (0
+    /// or 1; not an error of the link).
+    pub host_joined_mid_frame: u32,
     /// The board's counters, from its last `Stats` (since its last boot).
     pub board: Option<Stats>,
     /// The final `Ping` was answered, so [`LinkReport::board`] is current.
@@ -127,9 +130,17 @@ impl fmt::Display for LinkReport {
                 self.best_score_sum / self.hypotheses_nonempty.max(1) as f64
             )?;
         }
+        let joined = if self.host_joined_mid_frame > 0 {
+            format!(
+                " ({} frame tail from before the port was opened, dropped)",
+                self.host_joined_mid_frame
+            )
+        } else {
+            String::new()
+        };
         writeln!(
             f,
-            "  host receiver: {}; {} late answers, {} board restart(s)",
+            "  host receiver: {}{joined}; {} late answers, {} board restart(s)",
             counters(&self.host_link),
             self.late_answers,
             self.restarts

@@ -189,6 +189,7 @@ impl Session {
         report.bytes_up = self.link.bytes_up();
         report.bytes_down = self.link.bytes_down();
         report.host_link = self.link.counters();
+        report.host_joined_mid_frame = self.link.joined_mid_frame();
         report.board_name = crate::text::escape_control(&self.hello.board);
         report
     }
