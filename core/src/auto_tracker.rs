@@ -25,8 +25,9 @@
 //!   the best taken for the hand if the search's acceptance test takes it. The work per frame
 //!   is bounded: one slide, one placement, the library's poses scored once, and
 //!   `local_starts` × [`LOCAL_REFINE_PASSES`] tracker passes. Only then does the global
-//!   search run — or sooner, once [`FinderConfig::local_frames_in_view`] local frames have
-//!   refined a start (the hand is back in view) without accepting any.
+//!   search run — or, with two or more cameras, sooner, once
+//!   [`FinderConfig::local_frames_in_view`] local frames have refined a start (the hand is
+//!   back in view) without accepting any.
 //! - While searching, [`AutoTracker::state`] holds the last state that claimed the hand (the
 //!   base state before the first acquisition), never a refused hypothesis.
 //!
@@ -679,7 +680,13 @@ impl AutoTracker {
             }
             if score > 0.0 {
                 self.local_in_view = self.local_in_view.saturating_add(1);
-                let most = u32::from(finder.local_frames_in_view);
+                // One camera's global search acquires too rarely to give the local one up
+                // early (FinderConfig::local_frames_in_view).
+                let most = if self.multi.tracker().cameras().len() >= 2 {
+                    u32::from(finder.local_frames_in_view)
+                } else {
+                    0
+                };
                 if most > 0 && self.local_in_view >= most {
                     self.local_left = 0;
                     self.following = None;

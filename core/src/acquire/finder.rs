@@ -61,10 +61,12 @@ pub struct FinderConfig {
     /// `LOCAL_REFINE_PASSES` tracker passes): the followed one and the library's first, then
     /// the slid and the placed variant, these two in turn when not all fit.
     pub local_starts: u8,
-    /// The local re-acquisition gives way to the global search after this many of its frames
-    /// refined a start that Gauss–Newton did not lose (the hand is back in view) without
-    /// accepting any (0: only after all its frames): a hand back in view that it cannot take
-    /// has turned or moved farther than its variants reach.
+    /// With two or more cameras, the local re-acquisition gives way to the global search
+    /// after this many of its frames refined a start that Gauss–Newton did not lose (the hand
+    /// is back in view) without accepting any (0: only after all its frames): a hand back in
+    /// view that it cannot take has turned or moved farther than its variants reach. With one
+    /// camera it runs all its frames: a single view's global search acquires too rarely
+    /// (measured: `docs/recovery.md`).
     pub local_frames_in_view: u8,
 }
 
