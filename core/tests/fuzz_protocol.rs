@@ -27,6 +27,23 @@ fn frame_of(message: &HostMessage) -> Vec<u8> {
     encode(message, &mut buf).unwrap().to_vec()
 }
 
+/// The messages `rx` decodes from `stream` fed in pieces of `piece` bytes, each encoded
+/// again (so they compare as bytes, NaN states included).
+fn decoded_frames(rx: &mut Rx, stream: &[u8], piece: usize) -> Vec<Vec<u8>> {
+    let mut got = Vec::new();
+    for chunk in stream.chunks(piece) {
+        let mut rest = chunk;
+        while !rest.is_empty() {
+            let (used, out) = rx.feed::<HostMessage>(rest);
+            if let Some(Ok(m)) = out {
+                got.push(frame_of(&m));
+            }
+            rest = &rest[used..];
+        }
+    }
+    got
+}
+
 /// A host message with owned data, so the strategy needs no borrowed buffer.
 #[derive(Debug, Clone)]
 enum Owned {
@@ -184,18 +201,7 @@ proptest! {
                 corrupted[i] = true;
             }
         }
-        let mut rx = Rx::new();
-        let mut got = Vec::new();
-        for chunk in stream.chunks(piece) {
-            let mut rest = chunk;
-            while !rest.is_empty() {
-                let (used, out) = rx.feed::<HostMessage>(rest);
-                if let Some(Ok(m)) = out {
-                    got.push(frame_of(&m));
-                }
-                rest = &rest[used..];
-            }
-        }
+        let got = decoded_frames(&mut Rx::new(), &stream, piece);
         // Every clean frame arrives, in order; nothing arrives that was not sent.
         let clean: Vec<Vec<u8>> = messages
             .iter()
@@ -226,20 +232,7 @@ proptest! {
         let frames: Vec<Vec<u8>> = tokens.iter().map(|&t| frame_of(&HostMessage::Ping(t))).collect();
         let stream: Vec<u8> = frames.concat();
         let cut = ((stream.len() as f64) * cut_share) as usize;
-        let feed_all = |rx: &mut Rx| {
-            let mut got = Vec::new();
-            for chunk in stream[cut..].chunks(piece) {
-                let mut rest = chunk;
-                while !rest.is_empty() {
-                    let (used, out) = rx.feed::<HostMessage>(rest);
-                    if let Some(Ok(m)) = out {
-                        got.push(frame_of(&m));
-                    }
-                    rest = &rest[used..];
-                }
-            }
-            got
-        };
+        let feed_all = |rx: &mut Rx| decoded_frames(rx, &stream[cut..], piece);
         // The frames whose body (all but the leading delimiter) is after the cut.
         let mut start = 0;
         let mut whole = Vec::new();

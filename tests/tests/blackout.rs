@@ -310,6 +310,29 @@ fn reacquired_after(
     (back, line)
 }
 
+/// `random-stereo` `seed` (140 frames, blackout 80..110) is re-acquired within 10 px under
+/// `with` and not under `without`: a mechanism shown on one seed, both ways.
+fn reacquired_only_with(seed: u64, with: FinderConfig, without: FinderConfig, what: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |finder| {
+        reacquired_after(
+            dir.path(),
+            "random-stereo",
+            seed,
+            140,
+            80..110,
+            finder,
+            10.0,
+        )
+    };
+    let (back, line) = run(with);
+    println!("with {what}:    {line}");
+    assert!(back.is_some(), "{seed} not re-acquired with {what}: {line}");
+    let (back, line) = run(without);
+    println!("without {what}: {line}");
+    assert!(back.is_none(), "{seed} re-acquired without {what}: {line}");
+}
+
 #[test]
 fn the_local_reacquisition_tries_the_librarys_finger_poses_under_the_last_good_palm() {
     // While the hand is hidden its fingers move on: started from the last good fingers,
@@ -319,34 +342,13 @@ fn the_local_reacquisition_tries_the_librarys_finger_poses_under_the_last_good_p
     // re-acquired only with it. (A seed that shows the mechanism, not a sweep's verdict:
     // over fresh seeds 1011-1170, of the 103 tracked up to the blackout, 84 are
     // re-acquired with it and 76 without; docs/recovery.md.)
-    let dir = tempfile::tempdir().unwrap();
     let with = FinderConfig::default();
     assert!(with.local_library_pose, "on by default");
     let without = FinderConfig {
         local_library_pose: false,
         ..with
     };
-    let (back, line) =
-        reacquired_after(dir.path(), "random-stereo", 1014, 140, 80..110, with, 10.0);
-    println!("with the library pose:    {line}");
-    assert!(
-        back.is_some(),
-        "not re-acquired with the library pose: {line}"
-    );
-    let (back, line) = reacquired_after(
-        dir.path(),
-        "random-stereo",
-        1014,
-        140,
-        80..110,
-        without,
-        10.0,
-    );
-    println!("without the library pose: {line}");
-    assert!(
-        back.is_none(),
-        "re-acquired without the library pose: {line}"
-    );
+    reacquired_only_with(1014, with, without, "the library pose");
 }
 
 #[test]
@@ -358,31 +360,13 @@ fn a_hand_back_in_view_that_the_local_reacquisition_cannot_take_goes_to_the_glob
     // re-acquired only so. (A seed that shows the mechanism: over fresh seeds 1091-1250,
     // 132 of 160 are re-acquired after the blackout with it and 122 without;
     // docs/recovery.md.)
-    let dir = tempfile::tempdir().unwrap();
     let with = FinderConfig::default();
     assert!(with.local_frames_in_view > 0, "on by default");
     let without = FinderConfig {
         local_frames_in_view: 0,
         ..with
     };
-    let (back, line) =
-        reacquired_after(dir.path(), "random-stereo", 1087, 140, 80..110, with, 10.0);
-    println!("global after 8 frames: {line}");
-    assert!(back.is_some(), "not re-acquired: {line}");
-    let (back, line) = reacquired_after(
-        dir.path(),
-        "random-stereo",
-        1087,
-        140,
-        80..110,
-        without,
-        10.0,
-    );
-    println!("local for all 60:      {line}");
-    assert!(
-        back.is_none(),
-        "re-acquired by the local search alone: {line}"
-    );
+    reacquired_only_with(1087, with, without, "the global search after 8 frames");
 }
 
 #[test]
