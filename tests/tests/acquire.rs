@@ -11,7 +11,6 @@ use digiteyes_core::auto_tracker::Status;
 use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::{FreeMask, Robust};
 use digiteyes_core::frame::FrameView;
-use digiteyes_core::likelihood::EdgeMap;
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::{render_scenario, RenderOptions, TrackerConfig};
@@ -146,11 +145,7 @@ fn hand_free_frames_are_never_claimed() {
                 .collect();
             // The search on this frame to its end, then its leaves on the same frame.
             for _ in 0..2 {
-                let maps: Vec<EdgeMap<'_>> = bufs
-                    .iter_mut()
-                    .zip(&views)
-                    .map(|(b, v)| EdgeMap::build(b, v, &acquire.likelihood).unwrap())
-                    .collect();
+                let maps = search::edge_maps(&mut bufs, &views, &acquire.likelihood);
                 match finder.step(&mut tracker, &views, &maps).unwrap() {
                     FinderStep::Found { verdict, .. } => {
                         panic!("{rig}: hand-free frame {k} claimed a hand: {verdict:?}")
@@ -190,11 +185,7 @@ fn the_search_keeps_its_budget_and_goes_on_where_it_left_off() {
         let views = frames::views(&images);
         let config = AcquireConfig::default();
         let mut bufs = search::buffers(&sequence.cameras, config.likelihood.stride_px);
-        let maps: Vec<EdgeMap<'_>> = bufs
-            .iter_mut()
-            .zip(&views)
-            .map(|(b, v)| EdgeMap::build(b, v, &config.likelihood).unwrap())
-            .collect();
+        let maps = search::edge_maps(&mut bufs, &views, &config.likelihood);
         let mut acquirer = search::acquirer(&sequence, config);
         // The budget is per camera: a stereo step scores as many hypotheses as a mono one.
         let budget = acquirer.budget(sequence.cameras.len());
@@ -404,11 +395,7 @@ fn the_library_pose_that_scores_best_is_the_nearest_the_hand() {
     let images = frames::images(&sequence, 0);
     let views = frames::views(&images);
     let mut bufs = search::buffers(&sequence.cameras, acquire.likelihood.stride_px);
-    let maps: Vec<EdgeMap<'_>> = bufs
-        .iter_mut()
-        .zip(&views)
-        .map(|(b, f)| EdgeMap::build(b, f, &acquire.likelihood).unwrap())
-        .collect();
+    let maps = search::edge_maps(&mut bufs, &views, &acquire.likelihood);
     let mut q = [0.0f32; MAX_STATES];
     q[..n].copy_from_slice(&truth);
     let fist = acquirer.with_pose(&q, FingerPose::Fist as usize);

@@ -12,7 +12,6 @@ use digiteyes_core::auto_tracker::Status;
 use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::hypotheses::{HypothesesConfig, MultiTracker};
-use digiteyes_core::likelihood::EdgeMap;
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::{render_scenario, RenderOptions};
@@ -130,11 +129,7 @@ fn a_leaf_from_an_earlier_frame_is_placed_where_the_hand_is_now() {
         let images = images(&sequence, 0);
         let views = views(&images);
         let mut bufs = search::buffers(&sequence.cameras, acquire.likelihood.stride_px);
-        let maps: Vec<EdgeMap<'_>> = bufs
-            .iter_mut()
-            .zip(&views)
-            .map(|(b, v)| EdgeMap::build(b, v, &acquire.likelihood).unwrap())
-            .collect();
+        let maps = search::edge_maps(&mut bufs, &views, &acquire.likelihood);
         let mut acquirer = search::acquirer(&sequence, acquire);
         // Where the hand was some frames ago: 50 mm across the first camera's view.
         let c0 = &sequence.cameras[0];

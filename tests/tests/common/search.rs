@@ -5,8 +5,9 @@ use digiteyes_core::acquire::{AcquireConfig, Acquirer, WorkingVolume};
 use digiteyes_core::auto_tracker::AutoTracker;
 use digiteyes_core::camera::Camera;
 use digiteyes_core::estimator::FreeMask;
+use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::likelihood::EdgeMap;
+use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig};
 use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::tracker::TrackerConfig;
 use digiteyes_host::sequence::Sequence;
@@ -64,6 +65,19 @@ pub fn buffers(cameras: &[Camera], stride_px: u8) -> Vec<Vec<u8>> {
     cameras
         .iter()
         .map(|c| vec![0u8; EdgeMap::bytes_needed(c.width as usize, c.height as usize, stride_px)])
+        .collect()
+}
+
+/// Each camera's edge map of `views` in its buffer of `buffers`.
+pub fn edge_maps<'b>(
+    buffers: &'b mut [Vec<u8>],
+    views: &[FrameView<'_>],
+    likelihood: &LikelihoodConfig,
+) -> Vec<EdgeMap<'b>> {
+    buffers
+        .iter_mut()
+        .zip(views)
+        .map(|(b, v)| EdgeMap::build(b, v, likelihood).unwrap())
         .collect()
 }
 
