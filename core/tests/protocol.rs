@@ -372,7 +372,7 @@ fn tracker_parameters_round_trip_and_are_range_checked() {
     assert_eq!(params.to_config().unwrap(), config);
 
     type Spoil = fn(&mut TrackerParams);
-    let bad: [(&str, Spoil); 12] = [
+    let bad: [(&str, Spoil); 15] = [
         ("iterations", |p| p.iterations = 0),
         ("slices_per_link", |p| p.slices_per_link = 200),
         ("window_px", |p| p.window_px = 2),
@@ -385,6 +385,9 @@ fn tracker_parameters_round_trip_and_are_range_checked() {
         ("max_edge_angle_rad", |p| p.max_edge_angle_rad = -0.1),
         ("max_edge_angle_rad", |p| p.max_edge_angle_rad = 2.0),
         ("max_edge_angle_rad", |p| p.max_edge_angle_rad = f32::NAN),
+        ("outermost_share", |p| p.outermost_share = -0.1),
+        ("outermost_share", |p| p.outermost_share = 1.5),
+        ("outermost_share", |p| p.outermost_share = f32::NAN),
     ];
     for (name, spoil) in bad {
         let mut p = params;

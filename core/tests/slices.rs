@@ -1,6 +1,8 @@
 //! The 1-D slice search on synthetic profiles with known sub-pixel edge positions.
 
-use digiteyes_core::features::{edge_runs_along, find_edge, find_valley, FeatureConfig, Polarity};
+use digiteyes_core::features::{
+    edge_runs_along, find_edge, find_outermost_edge, find_valley, FeatureConfig, Polarity,
+};
 use digiteyes_core::frame::FrameView;
 use nalgebra::Vector2;
 
@@ -78,6 +80,46 @@ fn the_strongest_of_two_edges_wins() {
     }
     let found = find_edge(&p, Polarity::DarkOutside, 4.0).expect("edge");
     assert!((found.position - 15.2).abs() < 0.1, "{}", found.position);
+}
+
+/// Two steps down: an inner one from `hi` to `mid` at `inner`, an outer one from `mid` to
+/// `lo` at `outer`: a hand-bright surface, a darker one beside it, then the background.
+fn two_steps(n: usize, inner: f32, outer: f32, [hi, mid, lo]: [f32; 3]) -> Vec<f32> {
+    let a = step_profile(n, inner, hi, mid);
+    let b = step_profile(n, outer, mid, lo);
+    a.iter().zip(&b).map(|(x, y)| x + y - mid).collect()
+}
+
+#[test]
+fn the_outermost_edge_at_least_a_share_of_the_strongest_wins() {
+    // The inner step drops 80 grey levels, the outer 55 (0.69 of it).
+    let p = two_steps(24, 6.2, 15.2, [160.0, 80.0, 25.0]);
+    let strongest = find_edge(&p, Polarity::DarkOutside, 4.0).expect("edge");
+    assert!(
+        (strongest.position - 6.2).abs() < 0.1,
+        "{}",
+        strongest.position
+    );
+    let outer = find_outermost_edge(&p, Polarity::DarkOutside, 4.0, 0.5).expect("edge");
+    assert!((outer.position - 15.2).abs() < 0.1, "{}", outer.position);
+    // Asked for 0.8 of the strongest, the outer step is too weak: the strongest stays.
+    let inner = find_outermost_edge(&p, Polarity::DarkOutside, 4.0, 0.8).expect("edge");
+    assert!((inner.position - 6.2).abs() < 0.1, "{}", inner.position);
+}
+
+#[test]
+fn with_one_edge_the_outermost_is_the_strongest() {
+    for i in 0..=40 {
+        let p = step_profile(20, 6.0 + i as f32 * 0.17, 150.0, 30.0);
+        assert_eq!(
+            find_outermost_edge(&p, Polarity::DarkOutside, 4.0, 0.5),
+            find_edge(&p, Polarity::DarkOutside, 4.0)
+        );
+    }
+    assert!(find_outermost_edge(&[80.0; 20], Polarity::Any, 4.0, 0.5).is_none());
+    assert!(find_outermost_edge(&[], Polarity::Any, 4.0, 0.5).is_none());
+    let wrong_sign = step_profile(20, 9.3, 25.0, 160.0);
+    assert!(find_outermost_edge(&wrong_sign, Polarity::DarkOutside, 4.0, 0.5).is_none());
 }
 
 #[test]

@@ -122,6 +122,9 @@ struct Args {
     /// The tracker's own edge-direction limit (degrees; 90: off; default: the tracker's).
     #[arg(long)]
     angle_deg: Option<f32>,
+    /// The tracker's outermost-edge share (0: the strongest edge; default: the tracker's).
+    #[arg(long)]
+    outermost_share: Option<f32>,
     /// Write every refined leaf's judgement and true error here (CSV).
     #[arg(long)]
     leaves_csv: Option<std::path::PathBuf>,
@@ -129,6 +132,11 @@ struct Args {
     /// search with acceptance off, and write their leaves' judgements to the CSV.
     #[arg(long, default_value_t = 0)]
     hand_free: usize,
+    /// Also run this many hand-free frames (the same kinds, in turn, each frame a new one)
+    /// through the status machine with its own acceptance, from searching, and count the
+    /// frames that claim a hand.
+    #[arg(long, default_value_t = 0)]
+    hand_free_status: usize,
     /// Also start the tracker at the truth of frame 10 and report whether it holds the hand
     /// (within the limit) for the next 5 frames: the most any search could give.
     #[arg(long)]
@@ -208,11 +216,17 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
 /// The tracker's edge-direction limit, when `--angle-deg` gives one (set once in `main`).
 static TRACKER_ANGLE_DEG: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
 
-/// The tracker's defaults, with `--angle-deg` if given.
+/// The tracker's outermost-edge share, when `--outermost-share` gives one (set once in `main`).
+static TRACKER_OUTERMOST: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
+
+/// The tracker's defaults, with `--angle-deg` and `--outermost-share` if given.
 fn tracker_config() -> TrackerConfig {
     let mut config = TrackerConfig::default();
     if let Some(degrees) = TRACKER_ANGLE_DEG.get() {
         config.features.max_edge_angle_rad = degrees.to_radians();
+    }
+    if let Some(share) = TRACKER_OUTERMOST.get() {
+        config.features.outermost_share = *share;
     }
     config
 }
@@ -696,6 +710,37 @@ fn hand_free(w: usize, h: usize, grey: u8, noise: u8, clutter: bool, seed: u64) 
     pixels
 }
 
+/// Hand-free frame `k` of every camera of `sequence`: its grey, noise and clutter seeded by
+/// `k` and the camera.
+fn hand_free_frames(sequence: &Sequence, k: usize, noise: u8, clutter: bool) -> Vec<Vec<u8>> {
+    sequence
+        .cameras
+        .iter()
+        .enumerate()
+        .map(|(c, cam)| {
+            let grey = 30 + (k * 7 % 40) as u8;
+            let seed = (k * 4 + c) as u64;
+            hand_free(
+                cam.width as usize,
+                cam.height as usize,
+                grey,
+                noise,
+                clutter,
+                seed,
+            )
+        })
+        .collect()
+}
+
+/// Views of one hand-free frame per camera.
+fn hand_free_views<'a>(sequence: &Sequence, frames: &'a [Vec<u8>]) -> Result<Vec<FrameView<'a>>> {
+    Ok(frames
+        .iter()
+        .zip(&sequence.cameras)
+        .map(|(p, c)| FrameView::packed(p, c.width as usize, c.height as usize))
+        .collect::<Result<_, _>>()?)
+}
+
 /// Hand-free frames through the search with acceptance off: every leaf's judgement.
 fn hand_free_run(sequence: &Sequence, args: &Args, csv: &mut Option<std::fs::File>) -> Result<f32> {
     let mut base = vec![0.0f32; sequence.n_states()];
@@ -718,27 +763,8 @@ fn hand_free_run(sequence: &Sequence, args: &Args, csv: &mut Option<std::fs::Fil
     let mut k = 0;
     while k < args.hand_free {
         let (noise, clutter, kind) = kinds[k % kinds.len()];
-        let frames: Vec<Vec<u8>> = sequence
-            .cameras
-            .iter()
-            .enumerate()
-            .map(|(c, cam)| {
-                let grey = 30 + (k * 7 % 40) as u8;
-                hand_free(
-                    cam.width as usize,
-                    cam.height as usize,
-                    grey,
-                    noise,
-                    clutter,
-                    (k * 4 + c) as u64,
-                )
-            })
-            .collect();
-        let views: Vec<_> = frames
-            .iter()
-            .zip(&sequence.cameras)
-            .map(|(p, c)| FrameView::packed(p, c.width as usize, c.height as usize))
-            .collect::<Result<_, _>>()?;
+        let frames = hand_free_frames(sequence, k, noise, clutter);
+        let views = hand_free_views(sequence, &frames)?;
         // The search to its end on this frame, then its leaves on the same frame.
         loop {
             let maps = edge_maps(&mut bufs, &views, &acquire)?;
@@ -767,10 +793,37 @@ fn hand_free_run(sequence: &Sequence, args: &Args, csv: &mut Option<std::fs::Fil
     Ok(worst)
 }
 
+/// `frames` hand-free frames through the status machine, from searching, with its own
+/// acceptance: the frames that claim a hand, and the best leaf score any frame refined.
+fn hand_free_status_run(sequence: &Sequence, args: &Args, frames: usize) -> Result<(usize, f32)> {
+    let (acquire, _) = configs(args);
+    let mut auto = auto_tracker(sequence, args, None)?;
+    let mut bufs = buffers(&sequence.cameras, &acquire);
+    let kinds = [(0u8, false), (8, false), (8, true), (0, true)];
+    let (mut claimed, mut best) = (0, 0.0f32);
+    for k in 0..frames {
+        let (noise, clutter) = kinds[k % kinds.len()];
+        let images = hand_free_frames(sequence, k, noise, clutter);
+        let views = hand_free_views(sequence, &images)?;
+        let mut buffers: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
+        let report = auto
+            .step(&views, &mut buffers)
+            .map_err(|e| anyhow!("{e}"))?;
+        if report.status != Status::Searching && !report.report.lost {
+            claimed += 1;
+        }
+        best = best.max(report.leaf_score.unwrap_or(0.0));
+    }
+    Ok((claimed, best))
+}
+
 fn main() -> Result<()> {
     let args = Args::parse();
     if let Some(degrees) = args.angle_deg {
         let _ = TRACKER_ANGLE_DEG.set(degrees);
+    }
+    if let Some(share) = args.outermost_share {
+        let _ = TRACKER_OUTERMOST.set(share);
     }
     if let Some(dark) = args.blackout.clone() {
         return blackout_sweep(&args, &dark);
@@ -820,6 +873,14 @@ fn main() -> Result<()> {
                 eprintln!(
                     "{rig}: {} hand-free frames, best leaf score {worst:.3}",
                     args.hand_free
+                );
+            }
+            if seed == *args.seeds.start() && args.hand_free_status > 0 {
+                let (claimed, best) =
+                    hand_free_status_run(&sequence, &args, args.hand_free_status)?;
+                eprintln!(
+                    "{rig}: {} hand-free frames through the status machine, {claimed} claimed; best leaf score {best:.3}",
+                    args.hand_free_status
                 );
             }
             std::fs::remove_dir_all(&seq)?;

@@ -60,6 +60,10 @@ struct Args {
     /// tracker's), to cost the test.
     #[arg(long)]
     edge_angle_deg: Option<f32>,
+    /// The slice search's outermost-edge share (0: the strongest edge; default: the
+    /// tracker's), to cost the choice.
+    #[arg(long)]
+    outermost_share: Option<f32>,
     /// The thesis' plain loop: no motion model, no silhouette check (the cost before them).
     #[arg(long)]
     plain: bool,
@@ -98,6 +102,9 @@ fn main() -> Result<()> {
     }
     if let Some(degrees) = args.edge_angle_deg {
         config.features.max_edge_angle_rad = degrees.to_radians();
+    }
+    if let Some(share) = args.outermost_share {
+        config.features.outermost_share = share;
     }
     if let Some(window) = args.window {
         config.features.window_px = window;

@@ -84,6 +84,8 @@ fn a_track_the_image_no_longer_supports_is_flagged() {
     config.features.palm_edges = false;
     // With the edge-direction test this seed is tracked right: off, to have a wrong track.
     config.features.max_edge_angle_rad = core::f32::consts::FRAC_PI_2;
+    // And so with the outermost edge (0 wrong frames claimed with it): off too.
+    config.features.outermost_share = 0.0;
     let a = dir.path().join("a.csv");
     let (watched, tips) = track_with(&seq, &a, WatchConfig::default(), config);
     let b = dir.path().join("b.csv");

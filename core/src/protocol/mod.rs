@@ -38,7 +38,10 @@ pub use params::{BadParameter, CameraParams, TrackerParams, WireResidual, WireRo
 /// anything to say, counted in `Measured::links` (docs/protocol.md §12).
 /// Version 7: `TrackerParams` gained `max_edge_angle_rad`, the slice search's test of an
 /// edge's direction (issue 9; docs/protocol.md §4).
-pub const PROTOCOL_VERSION: u8 = 7;
+/// Version 8: `TrackerParams` gained `outermost_share`, the slice search's choice of the
+/// outermost edge where the model expects the background outside (issue 9; docs/protocol.md
+/// §4).
+pub const PROTOCOL_VERSION: u8 = 8;
 
 /// Largest `FrameChunk` payload (bytes).
 pub const MAX_CHUNK: usize = 1024;

@@ -121,6 +121,10 @@ pub struct TrackerParams {
     /// predicted one (rad, 0–π/2; π/2 keeps every edge; version 7;
     /// `FeatureConfig::max_edge_angle_rad`).
     pub max_edge_angle_rad: f32,
+    /// Where the model says an edge lies against the background, the outermost edge at
+    /// least this share of the window's strongest is taken (0–1; 0 takes the strongest;
+    /// version 8; `FeatureConfig::outermost_share`).
+    pub outermost_share: f32,
 }
 
 /// A tracker parameter out of range.
@@ -163,6 +167,7 @@ impl TrackerParams {
             lost_rms_px: config.lost_rms_px,
             palm_edges: config.features.palm_edges,
             max_edge_angle_rad: config.features.max_edge_angle_rad,
+            outermost_share: config.features.outermost_share,
         }
     }
 
@@ -190,6 +195,10 @@ impl TrackerParams {
             (0.0..=core::f32::consts::FRAC_PI_2).contains(&self.max_edge_angle_rad),
             "max_edge_angle_rad",
         )?;
+        check(
+            (0.0..=1.0).contains(&self.outermost_share),
+            "outermost_share",
+        )?;
         let robust = match self.robust {
             WireRobust::None => Robust::None,
             WireRobust::Huber(k) if positive(k) => Robust::Huber(k),
@@ -204,6 +213,7 @@ impl TrackerParams {
         features.min_contrast = self.min_contrast;
         features.palm_edges = self.palm_edges;
         features.max_edge_angle_rad = self.max_edge_angle_rad;
+        features.outermost_share = self.outermost_share;
         let mut estimator = defaults.estimator;
         estimator.residual = match self.residual {
             WireResidual::EdgePoints => ResidualKind::EdgePoints,
