@@ -78,7 +78,7 @@ pub struct FeatureConfig {
     /// strongest is taken rather than the strongest ([`find_outermost_edge`]; 0: the
     /// strongest). The hand's outline against the background is the last drop going
     /// outward; a stronger one inside it is the hand's own shading or another finger lying
-    /// inside the outline. Default 0.5: stereo track life +5.6 points on 270 fresh seeds, mono
+    /// inside the outline. Default 0.5: stereo track life +4.9 points on 360 fresh seeds, mono
     /// level (`docs/robustness.md`, "The outermost edge").
     pub outermost_share: f32,
 }
