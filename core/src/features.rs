@@ -200,7 +200,9 @@ pub fn find_outermost_edge(
     let (d, n) = oriented_derivative(profile, polarity)?;
     let peaks = || (3..n - 3).filter(|&k| is_peak(&d, k, min_contrast));
     let strongest = peaks().map(|k| d[k]).fold(0.0f32, f32::max);
-    let k = peaks().rev().find(|&k| d[k] >= share * strongest)?;
+    // A share above 1 (or NaN) would refuse even the strongest peak: it is taken as 1.
+    let bar = share.min(1.0) * strongest;
+    let k = peaks().rev().find(|&k| d[k] >= bar)?;
     Some(edge_at(&d, k))
 }
 

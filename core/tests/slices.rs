@@ -105,6 +105,15 @@ fn the_outermost_edge_at_least_a_share_of_the_strongest_wins() {
     // Asked for 0.8 of the strongest, the outer step is too weak: the strongest stays.
     let inner = find_outermost_edge(&p, Polarity::DarkOutside, 4.0, 0.8).expect("edge");
     assert!((inner.position - 6.2).abs() < 0.1, "{}", inner.position);
+    // A share above 1, or NaN, is taken as 1: the strongest, never nothing.
+    for share in [1.5, f32::NAN] {
+        let e = find_outermost_edge(&p, Polarity::DarkOutside, 4.0, share).expect("edge");
+        assert!(
+            (e.position - 6.2).abs() < 0.1,
+            "share {share}: {}",
+            e.position
+        );
+    }
 }
 
 #[test]

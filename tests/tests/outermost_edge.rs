@@ -5,7 +5,7 @@
 //! it (`docs/robustness.md`, "The outermost edge"). Tracked here by the plain tracker from the
 //! true first state, so the feature search alone makes the difference.
 
-use digiteyes_core::tracker::{Tracker, TrackerConfig};
+use digiteyes_core::tracker::TrackerConfig;
 use digiteyes_host::scenarios::{render_scenario, RenderOptions};
 use digiteyes_host::sequence::Sequence;
 
@@ -15,21 +15,13 @@ use common::{frames, search};
 /// Mean fingertip error (px, every camera) of each of the first `n` frames of `seq`, tracked
 /// from the true first state with `config`.
 fn tip_errors_px(seq: &Sequence, n: usize, config: TrackerConfig) -> Vec<f32> {
-    let truth = seq.read_truth().unwrap();
-    let state = |k: usize| -> Vec<f32> { truth.rows[k].iter().map(|&v| v as f32).collect() };
-    let mut tracker = Tracker::new(
-        seq.model.clone(),
-        &seq.cameras,
-        &state(0),
-        seq.free_mask(),
-        config,
-    )
-    .unwrap();
+    let truth = frames::truth_states(seq);
+    let mut tracker = frames::tracker_at(seq, &truth[0], config);
     (0..n)
         .map(|k| {
             let images = frames::images(seq, k);
             tracker.track(&frames::views(&images)).unwrap();
-            search::tip_error_px(&seq.model, &seq.cameras, tracker.state(), &state(k))
+            search::tip_error_px(&seq.model, &seq.cameras, tracker.state(), &truth[k])
         })
         .collect()
 }

@@ -10,11 +10,13 @@
 //! The seed is rendered under the fixed light it was found under: with the lighting the sweep
 //! now draws for it, the defect is milder (28° without the palm edges, 21° with them).
 
-use digiteyes_core::frame::FrameView;
-use digiteyes_core::tracker::{Tracker, TrackerConfig};
+use digiteyes_core::tracker::TrackerConfig;
 use digiteyes_host::render::Lighting;
 use digiteyes_host::scenarios::{render_scenario, RenderOptions};
 use digiteyes_host::sequence::Sequence;
+
+mod common;
+use common::frames;
 
 /// Angle between the palm rotations of two states (deg), by their quaternions `q0..q3`.
 fn palm_rotation_deg(a: &[f32], b: &[f32]) -> f32 {
@@ -24,31 +26,16 @@ fn palm_rotation_deg(a: &[f32], b: &[f32]) -> f32 {
     2.0 * cos.acos().to_degrees()
 }
 
-/// Tracks the first `frames` frames of `seq` from the true first state with `config`, never
+/// Tracks the first `n` frames of `seq` from the true first state with `config`, never
 /// recovering; returns the largest palm rotation error (deg) over them.
-fn worst_palm_deg(seq: &Sequence, frames: usize, config: TrackerConfig) -> f32 {
-    let truth = seq.read_truth().unwrap();
-    let state = |k: usize| -> Vec<f32> { truth.rows[k].iter().map(|&v| v as f32).collect() };
-    let mut tracker = Tracker::new(
-        seq.model.clone(),
-        &seq.cameras,
-        &state(0),
-        seq.free_mask(),
-        config,
-    )
-    .unwrap();
+fn worst_palm_deg(seq: &Sequence, n: usize, config: TrackerConfig) -> f32 {
+    let truth = frames::truth_states(seq);
+    let mut tracker = frames::tracker_at(seq, &truth[0], config);
     let mut worst = 0.0f32;
-    for k in 0..frames {
-        let images: Vec<_> = (0..seq.cameras.len())
-            .map(|c| seq.read_frame(c, k).unwrap())
-            .collect();
-        let views: Vec<FrameView<'_>> = images
-            .iter()
-            .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
-            .collect::<Result<_, _>>()
-            .unwrap();
-        tracker.track(&views).unwrap();
-        worst = worst.max(palm_rotation_deg(tracker.state(), &state(k)));
+    for (k, state) in truth.iter().enumerate().take(n) {
+        let images = frames::images(seq, k);
+        tracker.track(&frames::views(&images)).unwrap();
+        worst = worst.max(palm_rotation_deg(tracker.state(), state));
     }
     worst
 }
