@@ -4,8 +4,9 @@
 //! - **Searching**: each frame moves the [`Finder`] on within its budget: the search places
 //!   and scores hypotheses; when it is over, its best leaves are refined by the tracker's
 //!   Gauss–Newton on the frames that follow and judged by the likelihood in every camera
-//!   ([`AcceptConfig`]); an accepted leaf is taken for the hand, and when every leaf is
-//!   refused the search starts over.
+//!   ([`AcceptConfig`]); an accepted leaf is taken for the hand — claimed from the next
+//!   frame, if that frame confirms it ([`FinderConfig::probation_max_drop`]) — and when
+//!   every leaf is refused the search starts over.
 //! - **Tracking**: the tracker runs — one hypothesis, or several ([`MultiTracker`], set by
 //!   [`AutoTracker::set_hypotheses`]); a lost frame makes the status [`Status::Lost`]. Every
 //!   few frames (eight at 320×240) the [watch](crate::watch) scores the tracked state by the likelihood in every
@@ -47,7 +48,7 @@ use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_HYPOTHESES, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
-use crate::hypotheses::{HypothesesConfig, Hypothesis, MultiTracker};
+use crate::hypotheses::{HypothesesConfig, Hypothesis, MultiReport, MultiTracker};
 use crate::likelihood::{EdgeMap, LikelihoodError};
 use crate::model::Model;
 pub use crate::status::Status;
@@ -142,6 +143,9 @@ pub struct AutoReport {
     pub leaf_score: Option<f32>,
     /// The frame was spent on the local re-acquisition around the last good state.
     pub local: bool,
+    /// A leaf (or local start) was accepted on this frame: the hand is claimed on it, or on
+    /// [probation](FinderConfig::probation_max_drop) once the next frame confirms it.
+    pub accepted: bool,
     /// Hypotheses carried to the next frame (1 with a single hypothesis and while searching).
     pub hypotheses: u8,
     /// The best hypothesis' likelihood score on a tracking frame with several hypotheses
@@ -153,6 +157,16 @@ pub struct AutoReport {
     /// The tracked state's likelihood score in its worst camera, on a frame the
     /// [watch](crate::watch) checked (a score under its bar made the frame lost).
     pub watch_score: Option<f32>,
+}
+
+/// A leaf accepted on the last frame and not yet claimed
+/// ([`FinderConfig::probation_max_drop`]): what the frame after it is judged against.
+#[derive(Debug, Clone, Copy)]
+struct Probation {
+    /// The accepted leaf's worst camera's likelihood score.
+    worst_camera: f32,
+    /// Local re-acquisition frames that were left, gone on with if the next frame refutes it.
+    local_left: u32,
 }
 
 /// A hypothesis refined on this frame: its state, its mean and worst camera's likelihood
@@ -220,6 +234,8 @@ pub struct AutoTracker {
     confirm_left: u32,
     /// The best hypothesis' scores summed over the confirming frames so far, and how many.
     confirm_scores: (f32, u32),
+    /// A leaf accepted on the last frame, claimed only if this frame confirms it.
+    probation: Option<Probation>,
 }
 
 impl AutoTracker {
@@ -256,6 +272,7 @@ impl AutoTracker {
             hypotheses: HypothesesConfig::default(),
             confirm_left: 0,
             confirm_scores: (0.0, 0),
+            probation: None,
         })
     }
 
@@ -328,18 +345,23 @@ impl AutoTracker {
 
     /// The state to report for the last frame: the tracker's while tracking or lost; while
     /// searching, the last state that claimed the hand (the base before the first
-    /// acquisition), never a hypothesis under test.
+    /// acquisition), never a hypothesis under test (nor one accepted and not yet confirmed).
     pub fn state(&self) -> &[f32] {
         let tracker = self.multi.tracker();
-        match self.status {
+        match self.status() {
             Status::Searching => &self.held[..tracker.state().len().min(MAX_STATES)],
             Status::Tracking | Status::Lost => tracker.state(),
         }
     }
 
-    /// The status after the last frame.
+    /// The status after the last frame (searching while an accepted leaf awaits the next
+    /// frame's confirmation).
     pub fn status(&self) -> Status {
-        self.status
+        if self.probation.is_some() {
+            Status::Searching
+        } else {
+            self.status
+        }
     }
 
     /// The tracker (its model, cameras, free states).
@@ -377,6 +399,22 @@ impl AutoTracker {
         edge_buffers: &mut [&mut [u8]],
     ) -> Result<AutoReport, AutoError> {
         let multi = self.multi.track(frames, edge_buffers)?;
+        let mut watch_score = None;
+        if let Some(probation) = self.probation.take() {
+            let confirmed = !multi.report.lost && {
+                let worst = self.worst_camera_score(frames, edge_buffers)?;
+                watch_score = Some(worst);
+                let drop = self
+                    .finder
+                    .config()
+                    .probation_max_drop
+                    .unwrap_or(f32::INFINITY);
+                worst >= probation.worst_camera - drop
+            };
+            if !confirmed {
+                return Ok(self.search_again(multi, probation.local_left, watch_score));
+            }
+        }
         let mut refuted = false;
         if self.confirm_left > 0 {
             self.confirm_left -= 1;
@@ -393,29 +431,13 @@ impl AutoTracker {
         let mut report = multi.report;
         if refuted && self.recovery == Recovery::Search {
             // Not the hand after all: search again from scratch.
-            self.finder.restart();
-            self.following = None;
-            self.local_left = 0;
-            self.lost_run = 0;
-            self.status = Status::Searching;
-            return Ok(AutoReport {
-                status: self.status,
-                report: FrameReport {
-                    lost: true,
-                    ..report
-                },
-                evaluated: 0,
-                leaf_score: None,
-                local: false,
-                hypotheses: multi.count,
-                best_score: multi.score,
-                switched: multi.switched,
-                watch_score: None,
-            });
+            return Ok(self.search_again(multi, 0, None));
         }
-        let mut watch_score = None;
         if !report.lost && self.recovery == Recovery::Search && self.watch.due() {
-            let worst = self.worst_camera_score(frames, edge_buffers)?;
+            let worst = match watch_score {
+                Some(worst) => worst,
+                None => self.worst_camera_score(frames, edge_buffers)?,
+            };
             watch_score = Some(worst);
             if self.watch.judge(worst) {
                 self.vouched = self.multi.tracker().memory().state;
@@ -457,11 +479,44 @@ impl AutoTracker {
             evaluated: 0,
             leaf_score: None,
             local: false,
+            accepted: false,
             hypotheses: multi.count,
             best_score: multi.score,
             switched: multi.switched,
             watch_score,
         })
+    }
+
+    /// The hand claimed (or about to be) was not the hand after all: the search goes on, the
+    /// local re-acquisition for `local_left` more frames, else the global search from scratch.
+    fn search_again(
+        &mut self,
+        multi: MultiReport,
+        local_left: u32,
+        watch_score: Option<f32>,
+    ) -> AutoReport {
+        self.finder.restart();
+        self.following = None;
+        self.confirm_left = 0;
+        self.multi.set_config(self.hypotheses);
+        self.local_left = local_left;
+        self.lost_run = 0;
+        self.status = Status::Searching;
+        AutoReport {
+            status: self.status,
+            report: FrameReport {
+                lost: true,
+                ..multi.report
+            },
+            evaluated: 0,
+            leaf_score: None,
+            local: false,
+            accepted: false,
+            hypotheses: multi.count,
+            best_score: multi.score,
+            switched: multi.switched,
+            watch_score,
+        }
     }
 
     /// The tracked state's likelihood score in its worst camera, each camera's edge map built
@@ -505,8 +560,12 @@ impl AutoTracker {
         self.ever_tracked = true;
     }
 
-    /// The tracker holds the hand (refined on this frame): the status becomes `Tracking`.
-    fn found(&mut self) {
+    /// The tracker holds the hand (refined on this frame, its worst camera scoring
+    /// `worst_camera`): the status becomes `Tracking`, and the hand is claimed now — or, on
+    /// [probation](FinderConfig::probation_max_drop), once the next frame confirms it.
+    /// Returns whether it is claimed now.
+    fn found(&mut self, worst_camera: f32) -> bool {
+        let local_left = self.local_left;
         self.confirm_left = 0;
         self.multi.set_config(self.hypotheses);
         self.multi.adopt();
@@ -515,7 +574,16 @@ impl AutoTracker {
         self.status = Status::Tracking;
         self.lost_run = 0;
         self.local_left = 0;
-        self.hold_tracked();
+        if self.finder.config().probation_max_drop.is_some() {
+            self.probation = Some(Probation {
+                worst_camera,
+                local_left,
+            });
+            false
+        } else {
+            self.hold_tracked();
+            true
+        }
     }
 
     /// After a leaf is accepted: when [`FinderConfig::confirm_frames`] asks, the other good
@@ -667,11 +735,12 @@ impl AutoTracker {
                 }
             }
             self.multi.tracker_mut().restart_fresh(&q[..n])?;
-            self.found();
+            let claimed = self.found(best.worst_camera);
             self.confirm(&others)?;
-            out.status = Status::Tracking;
+            out.accepted = true;
+            out.status = self.status();
             out.report = FrameReport {
-                lost: false,
+                lost: !claimed,
                 ..report
             };
         } else {
@@ -785,16 +854,17 @@ impl AutoTracker {
                 out.leaf_score = best_leaf.map(|v| v.score);
             }
             FinderStep::Found { verdict, report } => {
-                self.found();
+                let claimed = self.found(verdict.worst_camera);
                 let mut others: Vec<[f32; MAX_STATES], MAX_KEEP> = Vec::new();
                 for q in self.finder.found_leaves().iter().skip(1) {
                     let _ = others.push(*q);
                 }
                 self.confirm(&others)?;
                 out.leaf_score = Some(verdict.score);
-                out.status = Status::Tracking;
+                out.accepted = true;
+                out.status = self.status();
                 out.report = FrameReport {
-                    lost: false,
+                    lost: !claimed,
                     ..report
                 };
             }

@@ -108,6 +108,10 @@ struct Args {
     /// Mean score over the confirming frames needed to keep the hand.
     #[arg(long)]
     confirm_min_score: Option<f32>,
+    /// How far the worst camera's score may fall on the frame after an acceptance before the
+    /// hand is claimed (negative: claimed on the accepting frame).
+    #[arg(long, allow_hyphen_values = true)]
+    probation_drop: Option<f32>,
     /// Score a leaf refined with the accepted one needs to join it.
     #[arg(long)]
     alternative_score: Option<f32>,
@@ -209,6 +213,11 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         local_library_pose: args.local_library.unwrap_or(f.local_library_pose),
         local_starts: args.local_starts.unwrap_or(f.local_starts),
         local_frames_in_view: args.local_in_view.unwrap_or(f.local_frames_in_view),
+        probation_max_drop: match args.probation_drop {
+            Some(d) if d < 0.0 => None,
+            Some(d) => Some(d),
+            None => f.probation_max_drop,
+        },
     };
     (acquire, finder)
 }
@@ -811,6 +820,10 @@ fn hand_free_status_run(sequence: &Sequence, args: &Args, frames: usize) -> Resu
             .map_err(|e| anyhow!("{e}"))?;
         if report.status != Status::Searching && !report.report.lost {
             claimed += 1;
+            eprintln!(
+                "  claimed hand-free frame {k} (noise {noise}, clutter {clutter}): best score {:.3}",
+                report.best_score
+            );
         }
         best = best.max(report.leaf_score.unwrap_or(0.0));
     }

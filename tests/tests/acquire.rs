@@ -16,53 +16,7 @@ use digiteyes_host::sequence::Sequence;
 use digiteyes_host::{render_scenario, RenderOptions, TrackerConfig};
 
 mod common;
-use common::{frames, search};
-
-/// A hand-free frame: the background's grey, optional noise, optional clutter (bright and
-/// dark bars at every angle), from a small deterministic generator.
-fn hand_free(
-    width: usize,
-    height: usize,
-    grey: u8,
-    noise: u8,
-    clutter: bool,
-    seed: u64,
-) -> Vec<u8> {
-    let mut state = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
-    let mut next = move || {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (state >> 33) as u32
-    };
-    let mut pixels = vec![grey; width * height];
-    if clutter {
-        for _ in 0..25 {
-            let (cx, cy) = (next() as usize % width, next() as usize % height);
-            let angle = (next() % 360) as f32 * std::f32::consts::PI / 180.0;
-            let (len, half) = (20 + next() as usize % 80, 2 + next() as usize % 5);
-            let level = if next() % 2 == 0 { 230 } else { 20 };
-            for t in 0..len {
-                for w in 0..2 * half {
-                    let x =
-                        cx as f32 + angle.cos() * t as f32 - angle.sin() * (w as f32 - half as f32);
-                    let y =
-                        cy as f32 + angle.sin() * t as f32 + angle.cos() * (w as f32 - half as f32);
-                    if x >= 0.0 && y >= 0.0 && (x as usize) < width && (y as usize) < height {
-                        pixels[y as usize * width + x as usize] = level;
-                    }
-                }
-            }
-        }
-    }
-    if noise > 0 {
-        for p in &mut pixels {
-            let n = (next() % (2 * u32::from(noise) + 1)) as i32 - i32::from(noise);
-            *p = (i32::from(*p) + n).clamp(0, 255) as u8;
-        }
-    }
-    pixels
-}
+use common::{frames, hand_free::hand_free, search};
 
 fn render(dir: &std::path::Path, scenario: &str, seed: u64, frames: usize) -> Sequence {
     let seq = dir.join(format!("{scenario}-{seed}"));

@@ -184,8 +184,9 @@ fn the_local_variants_turn_and_move_the_last_good_state() {
     }
 }
 
-/// The first frame of `sequence` the auto tracker claims the hand on, and the hypotheses it
-/// carries on that frame and the next `frames` frames.
+/// The first frame of `sequence` the auto tracker accepts the hand on (claimed on the next,
+/// once confirmed: `FinderConfig::probation_max_drop`), and the status and hypotheses of the
+/// next `frames` frames.
 fn acquire(sequence: &Sequence, finder: FinderConfig, frames: usize) -> (usize, Vec<(Status, u8)>) {
     let (mut auto, mut bufs) = search::searching(sequence, AcquireConfig::default());
     auto.set_finder(finder);
@@ -195,7 +196,7 @@ fn acquire(sequence: &Sequence, finder: FinderConfig, frames: usize) -> (usize, 
         let images = images(sequence, k);
         let mut b: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
         let r = auto.step(&views(&images), &mut b).unwrap();
-        if found.is_none() && r.status == Status::Tracking {
+        if found.is_none() && r.accepted {
             found = Some(k);
         } else if found.is_some() && after.len() < frames {
             after.push((r.status, auto.hypotheses().len() as u8));

@@ -68,6 +68,12 @@ pub struct FinderConfig {
     /// camera it runs all its frames: a single view's global search acquires too rarely
     /// (measured: `docs/recovery.md`).
     pub local_frames_in_view: u8,
+    /// An accepted leaf (or local start) is claimed only once the next frame confirms it:
+    /// the tracker does not lose it there and its worst camera scores at most this under the
+    /// acceptance's worst camera (likelihood units); else the search goes on. A hypothesis
+    /// fitted to clutter or noise by Gauss–Newton rarely survives a second frame; the hand
+    /// does. `None`: claimed on the accepting frame itself.
+    pub probation_max_drop: Option<f32>,
 }
 
 impl Default for FinderConfig {
@@ -87,6 +93,7 @@ impl Default for FinderConfig {
             local_library_pose: true,
             local_starts: 3,
             local_frames_in_view: 8,
+            probation_max_drop: Some(0.10),
         }
     }
 }

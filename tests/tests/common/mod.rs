@@ -3,6 +3,7 @@
 
 pub mod browser;
 pub mod frames;
+pub mod hand_free;
 pub mod search;
 
 use std::path::{Path, PathBuf};
