@@ -79,10 +79,6 @@ pub const LOCAL_FOLLOW_SCORE: f32 = 0.8;
 /// How far the local re-acquisition turns the last good state's palm in its variants (rad).
 pub const LOCAL_TURN_RAD: f32 = 0.3;
 
-/// How far the local re-acquisition moves the last good state's palm in depth in its
-/// variants, as a share of its distance from the first camera.
-pub const LOCAL_DEPTH_SHARE: f32 = 0.15;
-
 /// What the tracker does once the hand has been lost for [`LOST_FRAMES_BEFORE_SEARCH`] frames.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -640,12 +636,18 @@ impl AutoTracker {
         };
         let seed = {
             let tracker = self.multi.tracker();
+            let [shared, one_camera] = self.finder.config().local_depth_share;
+            let depth_share = if tracker.cameras().len() >= 2 {
+                shared
+            } else {
+                one_camera
+            };
             self.finder.acquirer().variant(
                 tracker.cameras(),
                 &self.held,
                 k,
                 LOCAL_TURN_RAD,
-                LOCAL_DEPTH_SHARE,
+                depth_share,
             )
         };
         let followed = self.following.take();

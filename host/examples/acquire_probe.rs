@@ -112,6 +112,9 @@ struct Args {
     /// hand is claimed (negative: claimed on the accepting frame).
     #[arg(long, allow_hyphen_values = true)]
     probation_drop: Option<f32>,
+    /// How far the local re-acquisition moves the palm in depth with one camera (a share).
+    #[arg(long)]
+    local_depth_mono: Option<f32>,
     /// Score a leaf refined with the accepted one needs to join it.
     #[arg(long)]
     alternative_score: Option<f32>,
@@ -218,6 +221,10 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             Some(d) => Some(d),
             None => f.probation_max_drop,
         },
+        local_depth_share: [
+            f.local_depth_share[0],
+            args.local_depth_mono.unwrap_or(f.local_depth_share[1]),
+        ],
     };
     (acquire, finder)
 }

@@ -2,7 +2,11 @@
 //! seed with each variant and prints the track-life distribution per group. A variant is
 //! `default` or `key=value` overrides joined by `+` (keys: `pj`, `pt`, `pq` the prior's
 //! weights; `sj`, `st`, `sq` the conditioning; `iters`, `predict`, `window`, `slices`,
-//! `palm`, `palmw`, `tipw`, `fvf`; `angle` the edge-direction limit in degrees (90: off); `huber`, `tukey` the robust kernel's px; `k`, `s`, `spawn` the hypotheses; `watch` its period).
+//! `palm`, `palmw`, `tipw`, `fvf`, `outer`; `angle` the edge-direction limit in degrees (90:
+//! off); `huber`, `tukey` the robust kernel's px; `k`, `s`, `spawn` the hypotheses; `watch`
+//! its period; `depth1` one camera's local depth share; `probation` the acceptance's
+//! probation drop, negative: off). Each group's row also gives
+//! its frames far from the hand and not flagged (`far`, as the benchmark counts them).
 //! Every variant after the first is also compared with the first seed by seed (paired):
 //! the mean change of track life, how many seeds gained or lost more than 5 points, and the
 //! two-sided sign test's p over those (the median of 30 seeds moves by 10–20 points between
@@ -15,7 +19,9 @@
 
 use anyhow::Result;
 use clap::Parser;
+use digiteyes_host::bench::robustness::FAR_PALM_MM;
 use digiteyes_host::eval::{evaluate, stats};
+use digiteyes_host::sequence::{read_states, Sequence};
 use digiteyes_host::track::track_sequence_opts;
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -60,7 +66,7 @@ fn main() -> Result<()> {
         .filter(|(n, _)| args.parity.is_none_or(|p| n % 2 == p))
         .collect();
     seeds.sort();
-    println!("variant group seeds life50 life10 ge95 joint50 tip50 lives");
+    println!("variant group seeds life50 life10 ge95 joint50 tip50 far lives");
     let mut first: Option<Vec<(u64, f64)>> = None;
     for name in &args.variants {
         let (config, options) = variant(name)?;
@@ -80,10 +86,10 @@ fn main() -> Result<()> {
                     let out = std::env::temp_dir()
                         .join(format!("kept_ab_{}_{seed}.csv", std::process::id()));
                     let r = track_sequence_opts(dir, &out, config, false, None, &options)
-                        .and_then(|_| evaluate(dir, &out));
+                        .and_then(|_| Ok((evaluate(dir, &out)?, far_unflagged(dir, &out)?)));
                     let _ = std::fs::remove_file(&out);
                     match r {
-                        Ok(r) => {
+                        Ok((r, far)) => {
                             let tip = r.cameras.iter().map(|c| c.fingertip_mean_px).sum::<f64>()
                                 / r.cameras.len() as f64;
                             results.lock().unwrap().push((
@@ -91,6 +97,7 @@ fn main() -> Result<()> {
                                 r.track_life,
                                 r.joint_rms_deg,
                                 tip,
+                                far,
                             ))
                         }
                         Err(e) => eprintln!("seed {seed}: {e:#}"),
@@ -114,12 +121,13 @@ fn main() -> Result<()> {
             let joint: Vec<f64> = g.iter().map(|r| r.2).collect();
             let tip: Vec<f64> = g.iter().map(|r| r.3).collect();
             let ge95 = life.iter().filter(|&&l| l >= 0.95).count() as f64 / life.len() as f64;
+            let far: usize = g.iter().map(|r| r.4).sum();
             let lives: Vec<String> = g
                 .iter()
                 .map(|r| format!("{}:{:.0}", r.0, 100.0 * r.1))
                 .collect();
             println!(
-                "{name} {group} {} {:.0}% {:.0}% {:.0}% {:.2} {:.2} {}",
+                "{name} {group} {} {:.0}% {:.0}% {:.0}% {:.2} {:.2} {far} {}",
                 g.len(),
                 100.0 * stats::percentile(&life, 0.5),
                 100.0 * stats::percentile(&life, 0.1),
@@ -171,4 +179,24 @@ fn sign_test(a: usize, b: usize) -> f64 {
         tail += choose;
     }
     (2.0 * tail / 2f64.powi(n as i32)).min(1.0)
+}
+
+/// Frames of the states at `out` whose palm is more than `FAR_PALM_MM` from the truth of the
+/// sequence at `dir` while not flagged lost (the benchmark's `far` column).
+fn far_unflagged(dir: &std::path::Path, out: &std::path::Path) -> Result<usize> {
+    let sequence = Sequence::open(dir)?;
+    let truth = sequence.read_truth()?;
+    let table = read_states(out, sequence.n_states())?;
+    let lost = table.extra("lost").unwrap_or_default();
+    Ok(table
+        .rows
+        .iter()
+        .zip(&truth.rows)
+        .enumerate()
+        .filter(|(k, (q, t))| {
+            let palm_mm = (4..7).map(|i| (q[i] - t[i]).powi(2)).sum::<f64>().sqrt();
+            let flagged = lost.get(*k).is_some_and(|&v| v != 0.0);
+            !flagged && (palm_mm.is_nan() || palm_mm > FAR_PALM_MM)
+        })
+        .count())
 }

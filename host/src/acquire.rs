@@ -2,7 +2,7 @@
 //! edge-map buffers owned here (a board keeps them in static memory instead).
 
 use anyhow::{anyhow, Result};
-use digiteyes_core::acquire::{AcceptConfig, AcquireConfig};
+use digiteyes_core::acquire::{AcceptConfig, AcquireConfig, FinderConfig};
 use digiteyes_core::auto_tracker::AutoTracker as CoreAutoTracker;
 pub use digiteyes_core::auto_tracker::{
     AutoReport, Recovery, Status, FALLBACK_DEPTH_MM, LOCAL_REFINE_PASSES, LOCAL_SEARCH_FRAMES,
@@ -72,6 +72,12 @@ impl AutoTracker {
     /// Sets the thresholds a refined leaf needs to be accepted.
     pub fn set_accept(&mut self, accept: AcceptConfig) {
         self.inner.set_accept(accept);
+    }
+
+    /// Sets how the search's leaves (and the local re-acquisition's starts) are refined and
+    /// judged, the acceptance included.
+    pub fn set_finder(&mut self, config: FinderConfig) {
+        self.inner.set_finder(config);
     }
 
     /// Sets how the image checks the track (`every_frames` 0: never).

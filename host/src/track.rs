@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Context, Result};
-use digiteyes_core::acquire::AcquireConfig;
+use digiteyes_core::acquire::{AcquireConfig, FinderConfig};
 use digiteyes_core::config::MAX_HYPOTHESES;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::HypothesesConfig;
@@ -72,6 +72,8 @@ pub struct TrackOptions {
     /// How the image checks the track ([`digiteyes_core::watch`]; not with
     /// [`Recovery::Never`]).
     pub watch: WatchConfig,
+    /// How the search's leaves and the local re-acquisition's starts are refined and judged.
+    pub finder: FinderConfig,
 }
 
 impl Default for TrackOptions {
@@ -82,6 +84,7 @@ impl Default for TrackOptions {
             acquire: AcquireConfig::default(),
             hypotheses: HypothesesConfig::default(),
             watch: WatchConfig::default(),
+            finder: FinderConfig::default(),
         }
     }
 }
@@ -303,6 +306,7 @@ pub fn sequence_auto_tracker(
     }
     .with_context(|| format!("{name}"))?;
     auto.set_recovery(options.recovery);
+    auto.set_finder(options.finder);
     auto.set_watch(options.watch);
     auto.set_hypotheses(hypotheses_config(options)?);
     Ok(auto)

@@ -74,6 +74,13 @@ pub struct FinderConfig {
     /// fitted to clutter or noise by Gauss–Newton rarely survives a second frame; the hand
     /// does. `None`: claimed on the accepting frame itself.
     pub probation_max_drop: Option<f32>,
+    /// How far the local re-acquisition's variants move the last good palm nearer and
+    /// farther along the first camera's ray, as a share of its distance, with two or more
+    /// cameras (`[0]`, 0.15) and with one (`[1]`, 0: not moved). One camera sees the hand's
+    /// depth only through its size, and bent fingers make a nearer hand look like a farther
+    /// one: a palm moved 15 % nearer was refined, accepted and held there, 90 mm from the
+    /// hand and never flagged (measured: `docs/recovery.md`).
+    pub local_depth_share: [f32; 2],
 }
 
 impl Default for FinderConfig {
@@ -94,6 +101,7 @@ impl Default for FinderConfig {
             local_starts: 3,
             local_frames_in_view: 8,
             probation_max_drop: Some(0.10),
+            local_depth_share: [0.15, 0.0],
         }
     }
 }
