@@ -4,9 +4,10 @@
 //! weights; `sj`, `st`, `sq` the conditioning; `iters`, `predict`, `window`, `slices`,
 //! `palm`, `palmw`, `tipw`, `fvf`, `outer`; `angle` the edge-direction limit in degrees (90:
 //! off); `huber`, `tukey` the robust kernel's px; `k`, `s`, `spawn` the hypotheses; `watch`
-//! its period; `depth1` one camera's local depth share; `probation` the acceptance's
+//! its period, `drop` its bar; `depth1` one camera's local depth share; `probation` the acceptance's
 //! probation drop, negative: off). Each group's row also gives
-//! its frames far from the hand and not flagged (`far`, as the benchmark counts them).
+//! its frames far from the hand and not flagged (`far`) and the lost flag's precision and
+//! recall (`lostP`, `lostR`), as the benchmark counts them.
 //! Every variant after the first is also compared with the first seed by seed (paired):
 //! the mean change of track life, how many seeds gained or lost more than 5 points, and the
 //! two-sided sign test's p over those (the median of 30 seeds moves by 10–20 points between
@@ -19,7 +20,8 @@
 
 use anyhow::Result;
 use clap::Parser;
-use digiteyes_host::bench::robustness::FAR_PALM_MM;
+use digiteyes_host::bench::robustness::{judge_frame, FAR_PALM_MM, TRULY_LOST_TIP_PX_AT_640};
+use digiteyes_host::eval::EvalReport;
 use digiteyes_host::eval::{evaluate, stats};
 use digiteyes_host::sequence::{read_states, Sequence};
 use digiteyes_host::track::track_sequence_opts;
@@ -66,7 +68,7 @@ fn main() -> Result<()> {
         .filter(|(n, _)| args.parity.is_none_or(|p| n % 2 == p))
         .collect();
     seeds.sort();
-    println!("variant group seeds life50 life10 ge95 joint50 tip50 far lives");
+    println!("variant group seeds life50 life10 ge95 joint50 tip50 far lostP lostR lives");
     let mut first: Option<Vec<(u64, f64)>> = None;
     for name in &args.variants {
         let (config, options) = variant(name)?;
@@ -85,11 +87,16 @@ fn main() -> Result<()> {
                     };
                     let out = std::env::temp_dir()
                         .join(format!("kept_ab_{}_{seed}.csv", std::process::id()));
-                    let r = track_sequence_opts(dir, &out, config, false, None, &options)
-                        .and_then(|_| Ok((evaluate(dir, &out)?, far_unflagged(dir, &out)?)));
+                    let r = track_sequence_opts(dir, &out, config, false, None, &options).and_then(
+                        |_| {
+                            let report = evaluate(dir, &out)?;
+                            let judged = judge(dir, &out, &report)?;
+                            Ok((report, judged))
+                        },
+                    );
                     let _ = std::fs::remove_file(&out);
                     match r {
-                        Ok((r, far)) => {
+                        Ok((r, judged)) => {
                             let tip = r.cameras.iter().map(|c| c.fingertip_mean_px).sum::<f64>()
                                 / r.cameras.len() as f64;
                             results.lock().unwrap().push((
@@ -97,7 +104,7 @@ fn main() -> Result<()> {
                                 r.track_life,
                                 r.joint_rms_deg,
                                 tip,
-                                far,
+                                judged,
                             ))
                         }
                         Err(e) => eprintln!("seed {seed}: {e:#}"),
@@ -121,13 +128,18 @@ fn main() -> Result<()> {
             let joint: Vec<f64> = g.iter().map(|r| r.2).collect();
             let tip: Vec<f64> = g.iter().map(|r| r.3).collect();
             let ge95 = life.iter().filter(|&&l| l >= 0.95).count() as f64 / life.len() as f64;
-            let far: usize = g.iter().map(|r| r.4).sum();
+            let far: usize = g.iter().map(|r| r.4.far).sum();
+            let both: usize = g.iter().map(|r| r.4.flagged_and_lost).sum();
+            let flagged: usize = both + g.iter().map(|r| r.4.flagged_only).sum::<usize>();
+            let truly: usize = both + g.iter().map(|r| r.4.lost_only).sum::<usize>();
+            let ratio = |a: usize, b: usize| if b == 0 { 1.0 } else { a as f64 / b as f64 };
+            let (precision, recall) = (ratio(both, flagged), ratio(both, truly));
             let lives: Vec<String> = g
                 .iter()
                 .map(|r| format!("{}:{:.0}", r.0, 100.0 * r.1))
                 .collect();
             println!(
-                "{name} {group} {} {:.0}% {:.0}% {:.0}% {:.2} {:.2} {far} {}",
+                "{name} {group} {} {:.0}% {:.0}% {:.0}% {:.2} {:.2} {far} {precision:.2} {recall:.2} {}",
                 g.len(),
                 100.0 * stats::percentile(&life, 0.5),
                 100.0 * stats::percentile(&life, 0.1),
@@ -181,22 +193,38 @@ fn sign_test(a: usize, b: usize) -> f64 {
     (2.0 * tail / 2f64.powi(n as i32)).min(1.0)
 }
 
-/// Frames of the states at `out` whose palm is more than `FAR_PALM_MM` from the truth of the
-/// sequence at `dir` while not flagged lost (the benchmark's `far` column).
-fn far_unflagged(dir: &std::path::Path, out: &std::path::Path) -> Result<usize> {
+/// What the lost flag and the palm did on a tracked seed, judged as the benchmark judges
+/// them: frames far from the hand and not flagged, and the lost flag against frames truly
+/// lost (flagged and lost, flagged only, lost only).
+#[derive(Debug, Clone, Copy, Default)]
+struct Judged {
+    far: usize,
+    flagged_and_lost: usize,
+    flagged_only: usize,
+    lost_only: usize,
+}
+
+/// [`Judged`] for the states at `out` of the sequence at `dir`, evaluated as `report`.
+fn judge(dir: &std::path::Path, out: &std::path::Path, report: &EvalReport) -> Result<Judged> {
     let sequence = Sequence::open(dir)?;
     let truth = sequence.read_truth()?;
     let table = read_states(out, sequence.n_states())?;
     let lost = table.extra("lost").unwrap_or_default();
-    Ok(table
-        .rows
-        .iter()
-        .zip(&truth.rows)
-        .enumerate()
-        .filter(|(k, (q, t))| {
-            let palm_mm = (4..7).map(|i| (q[i] - t[i]).powi(2)).sum::<f64>().sqrt();
-            let flagged = lost.get(*k).is_some_and(|&v| v != 0.0);
-            !flagged && (palm_mm.is_nan() || palm_mm > FAR_PALM_MM)
-        })
-        .count())
+    let width = sequence.cameras.first().map_or(640, |c| c.width);
+    let tip_limit = TRULY_LOST_TIP_PX_AT_640 * f64::from(width) / 640.0;
+    let mut judged = Judged::default();
+    for (k, (q, t)) in table.rows.iter().zip(&truth.rows).enumerate() {
+        let (palm_mm, truly) = judge_frame(q, t, report, k, tip_limit);
+        let flagged = lost.get(k).is_some_and(|&v| v != 0.0);
+        match (flagged, truly) {
+            (true, true) => judged.flagged_and_lost += 1,
+            (true, false) => judged.flagged_only += 1,
+            (false, true) => judged.lost_only += 1,
+            (false, false) => {}
+        }
+        if !flagged && (palm_mm.is_nan() || palm_mm > FAR_PALM_MM) {
+            judged.far += 1;
+        }
+    }
+    Ok(judged)
 }

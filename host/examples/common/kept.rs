@@ -82,6 +82,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "spawn" => o.hypotheses.spawn_per_frame = f as u8,
             "k" => o.hypotheses.count = f as u8,
             "watch" => o.watch.every_frames = f as u8,
+            "drop" => o.watch.max_drop = f,
             "depth1" => o.finder.local_depth_share[1] = f,
             "probation" => o.finder.probation_max_drop = (f >= 0.0).then_some(f),
             _ => bail!("unknown key {k}"),
