@@ -144,6 +144,11 @@ struct Args {
     /// frames that claim a hand.
     #[arg(long, default_value_t = 0)]
     hand_free_status: usize,
+    /// With --hand-free-status: a still scene instead (one cluttered background per run,
+    /// `hand_free_status_run`'s `still` seed, with fresh noise ±8 on every frame), as a fixed
+    /// camera over a cluttered desk sees it.
+    #[arg(long)]
+    hand_free_still: Option<u64>,
     /// Also start the tracker at the truth of frame 10 and report whether it holds the hand
     /// (within the limit) for the next 5 frames: the most any search could give.
     #[arg(long)]
@@ -726,6 +731,36 @@ fn hand_free(w: usize, h: usize, grey: u8, noise: u8, clutter: bool, seed: u64) 
     pixels
 }
 
+/// Frame `k` of a still hand-free scene for every camera of `sequence`: the cluttered
+/// background `scene` (its grey and bars fixed), with noise ±8 drawn afresh for frame `k`.
+fn still_frames(sequence: &Sequence, scene: u64, k: usize) -> Vec<Vec<u8>> {
+    sequence
+        .cameras
+        .iter()
+        .enumerate()
+        .map(|(c, cam)| {
+            let grey = 30 + (scene as usize * 7 % 40) as u8;
+            let mut pixels = hand_free(
+                cam.width as usize,
+                cam.height as usize,
+                grey,
+                0,
+                true,
+                scene * 4 + c as u64,
+            );
+            let mut state = (k as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ c as u64;
+            for p in &mut pixels {
+                state = state
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1_442_695_040_888_963_407);
+                let n = ((state >> 33) % 17) as i32 - 8;
+                *p = (i32::from(*p) + n).clamp(0, 255) as u8;
+            }
+            pixels
+        })
+        .collect()
+}
+
 /// Hand-free frame `k` of every camera of `sequence`: its grey, noise and clutter seeded by
 /// `k` and the camera.
 fn hand_free_frames(sequence: &Sequence, k: usize, noise: u8, clutter: bool) -> Vec<Vec<u8>> {
@@ -819,7 +854,10 @@ fn hand_free_status_run(sequence: &Sequence, args: &Args, frames: usize) -> Resu
     let (mut claimed, mut best) = (0, 0.0f32);
     for k in 0..frames {
         let (noise, clutter) = kinds[k % kinds.len()];
-        let images = hand_free_frames(sequence, k, noise, clutter);
+        let images = match args.hand_free_still {
+            Some(scene) => still_frames(sequence, scene, k),
+            None => hand_free_frames(sequence, k, noise, clutter),
+        };
         let views = hand_free_views(sequence, &images)?;
         let mut buffers: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
         let report = auto
