@@ -728,7 +728,10 @@ impl AutoTracker {
         let (score, q, report) = (best.score, best.q, best.report);
         out.leaf_score = Some(score);
         let finder = *self.finder.config();
-        let verdict = finder.accept.judge(score, best.worst_camera, report.lost);
+        let cameras = self.multi.tracker().cameras().len();
+        let verdict = finder
+            .accept
+            .judge(cameras, score, best.worst_camera, report.lost);
         if verdict.accepted {
             let mut others: Vec<[f32; MAX_STATES], 3> = Vec::new();
             for r in refined.iter().skip(1) {

@@ -120,6 +120,9 @@ struct Args {
     alternative_score: Option<f32>,
     #[arg(long)]
     min_camera_score: Option<f32>,
+    /// The score a leaf needs with one camera.
+    #[arg(long)]
+    one_camera_score: Option<f32>,
     /// The robust weight leaves are refined under: `huber=K`, `tukey=C` (px) or `none`.
     #[arg(long)]
     leaf_robust: Option<String>,
@@ -205,6 +208,7 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         accept: AcceptConfig {
             min_score: args.min_score.unwrap_or(f.accept.min_score),
             min_camera_score: args.min_camera_score.unwrap_or(f.accept.min_camera_score),
+            one_camera_score: args.one_camera_score.unwrap_or(f.accept.one_camera_score),
         },
         replace_leaves: args.replace.unwrap_or(f.replace_leaves),
         confirm_frames: args.confirm_frames.unwrap_or(f.confirm_frames),

@@ -334,7 +334,9 @@ impl Finder {
                 .score_cameras(tracker.model(), &cameras[..n_cameras], frames, edges, &q)
         };
         Ok((
-            self.config.accept.judge(score, worst, report.lost),
+            self.config
+                .accept
+                .judge(tracker.cameras().len(), score, worst, report.lost),
             q,
             report,
         ))
