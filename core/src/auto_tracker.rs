@@ -155,6 +155,27 @@ pub struct AutoReport {
     pub watch_score: Option<f32>,
 }
 
+impl AutoReport {
+    /// The report of a frame the tracker ran on (tracking, lost, or refuted): `report` for
+    /// the status `status`, with the hypotheses' figures from `multi`.
+    fn tracked(
+        status: Status,
+        report: FrameReport,
+        multi: &MultiReport,
+        watch_score: Option<f32>,
+    ) -> Self {
+        AutoReport {
+            status,
+            report,
+            hypotheses: multi.count,
+            best_score: multi.score,
+            switched: multi.switched,
+            watch_score,
+            ..AutoReport::default()
+        }
+    }
+}
+
 /// A leaf accepted on the last frame and not yet claimed
 /// ([`FinderConfig::probation_max_drop`]): what the frame after it is judged against.
 #[derive(Debug, Clone, Copy)]
@@ -469,18 +490,12 @@ impl AutoTracker {
             self.status = Status::Tracking;
             self.hold_tracked();
         }
-        Ok(AutoReport {
-            status: self.status,
+        Ok(AutoReport::tracked(
+            self.status,
             report,
-            evaluated: 0,
-            leaf_score: None,
-            local: false,
-            accepted: false,
-            hypotheses: multi.count,
-            best_score: multi.score,
-            switched: multi.switched,
+            &multi,
             watch_score,
-        })
+        ))
     }
 
     /// The hand claimed (or about to be) was not the hand after all: the search goes on, the
@@ -498,21 +513,11 @@ impl AutoTracker {
         self.local_left = local_left;
         self.lost_run = 0;
         self.status = Status::Searching;
-        AutoReport {
-            status: self.status,
-            report: FrameReport {
-                lost: true,
-                ..multi.report
-            },
-            evaluated: 0,
-            leaf_score: None,
-            local: false,
-            accepted: false,
-            hypotheses: multi.count,
-            best_score: multi.score,
-            switched: multi.switched,
-            watch_score,
-        }
+        let report = FrameReport {
+            lost: true,
+            ..multi.report
+        };
+        AutoReport::tracked(self.status, report, &multi, watch_score)
     }
 
     /// The tracked state's likelihood score in its worst camera, each camera's edge map built

@@ -39,6 +39,7 @@ use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig, StateScorer};
 use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::tracker::Tracker;
+use digiteyes_host::render::hand_free::{hand_free, hand_free_frame, KINDS};
 use digiteyes_host::scenarios::{render_scenario, RenderOptions};
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::TrackerConfig;
@@ -696,45 +697,6 @@ fn oracle_holds(sequence: &Sequence, start: usize, limit: f32) -> Result<bool> {
     Ok(true)
 }
 
-/// A hand-free frame: a grey background, optional noise, optional clutter (bright and dark
-/// bars at every angle), from a small deterministic generator (as tests/tests/acquire.rs).
-fn hand_free(w: usize, h: usize, grey: u8, noise: u8, clutter: bool, seed: u64) -> Vec<u8> {
-    let mut state = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
-    let mut next = move || {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (state >> 33) as u32
-    };
-    let mut pixels = vec![grey; w * h];
-    if clutter {
-        for _ in 0..25 {
-            let (cx, cy) = (next() as usize % w, next() as usize % h);
-            let angle = (next() % 360) as f32 * std::f32::consts::PI / 180.0;
-            let (len, half) = (20 + next() as usize % 80, 2 + next() as usize % 5);
-            let level = if next() % 2 == 0 { 230 } else { 20 };
-            for t in 0..len {
-                for s in 0..2 * half {
-                    let x =
-                        cx as f32 + angle.cos() * t as f32 - angle.sin() * (s as f32 - half as f32);
-                    let y =
-                        cy as f32 + angle.sin() * t as f32 + angle.cos() * (s as f32 - half as f32);
-                    if x >= 0.0 && y >= 0.0 && (x as usize) < w && (y as usize) < h {
-                        pixels[y as usize * w + x as usize] = level;
-                    }
-                }
-            }
-        }
-    }
-    if noise > 0 {
-        for p in &mut pixels {
-            let n = (next() % (2 * u32::from(noise) + 1)) as i32 - i32::from(noise);
-            *p = (i32::from(*p) + n).clamp(0, 255) as u8;
-        }
-    }
-    pixels
-}
-
 /// Frame `k` of a still hand-free scene for every camera of `sequence`: the cluttered
 /// background `scene` (its grey and bars fixed), with noise ±8 drawn afresh for frame `k`.
 fn still_frames(sequence: &Sequence, scene: u64, k: usize) -> Vec<Vec<u8>> {
@@ -765,26 +727,15 @@ fn still_frames(sequence: &Sequence, scene: u64, k: usize) -> Vec<Vec<u8>> {
         .collect()
 }
 
-/// Hand-free frame `k` of every camera of `sequence`: its grey, noise and clutter seeded by
-/// `k` and the camera.
-fn hand_free_frames(sequence: &Sequence, k: usize, noise: u8, clutter: bool) -> Vec<Vec<u8>> {
-    sequence
+/// Hand-free frame `k` of every camera of `sequence` ([`hand_free_frame`]: its kind, grey
+/// and clutter set by `k` and the camera).
+fn hand_free_frames(sequence: &Sequence, k: usize) -> Vec<Vec<u8>> {
+    let sizes: Vec<(usize, usize)> = sequence
         .cameras
         .iter()
-        .enumerate()
-        .map(|(c, cam)| {
-            let grey = 30 + (k * 7 % 40) as u8;
-            let seed = (k * 4 + c) as u64;
-            hand_free(
-                cam.width as usize,
-                cam.height as usize,
-                grey,
-                noise,
-                clutter,
-                seed,
-            )
-        })
-        .collect()
+        .map(|c| (c.width as usize, c.height as usize))
+        .collect();
+    hand_free_frame(&sizes, k)
 }
 
 /// Views of one hand-free frame per camera.
@@ -809,16 +760,12 @@ fn hand_free_run(sequence: &Sequence, args: &Args, csv: &mut Option<std::fs::Fil
     let (mut tracker, mut finder) = new_finder(sequence, &base, &args_off)?;
     let mut bufs = buffers(&sequence.cameras, &acquire);
     let mut worst = 0.0f32;
-    let kinds = [
-        (0u8, false, "plain"),
-        (8, false, "noisy"),
-        (8, true, "cluttered"),
-        (0, true, "clutter"),
-    ];
+    // The names of hand_free::KINDS, in its order.
+    let names = ["plain", "noisy", "cluttered", "clutter"];
     let mut k = 0;
     while k < args.hand_free {
-        let (noise, clutter, kind) = kinds[k % kinds.len()];
-        let frames = hand_free_frames(sequence, k, noise, clutter);
+        let kind = names[k % KINDS.len()];
+        let frames = hand_free_frames(sequence, k);
         let views = hand_free_views(sequence, &frames)?;
         // The search to its end on this frame, then its leaves on the same frame.
         loop {
@@ -854,13 +801,12 @@ fn hand_free_status_run(sequence: &Sequence, args: &Args, frames: usize) -> Resu
     let (acquire, _) = configs(args);
     let mut auto = auto_tracker(sequence, args, None)?;
     let mut bufs = buffers(&sequence.cameras, &acquire);
-    let kinds = [(0u8, false), (8, false), (8, true), (0, true)];
     let (mut claimed, mut best) = (0, 0.0f32);
     for k in 0..frames {
-        let (noise, clutter) = kinds[k % kinds.len()];
+        let (noise, clutter) = KINDS[k % KINDS.len()];
         let images = match args.hand_free_still {
             Some(scene) => still_frames(sequence, scene, k),
-            None => hand_free_frames(sequence, k, noise, clutter),
+            None => hand_free_frames(sequence, k),
         };
         let views = hand_free_views(sequence, &images)?;
         let mut buffers: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();

@@ -20,10 +20,8 @@
 
 use anyhow::Result;
 use clap::Parser;
-use digiteyes_host::bench::robustness::{judge_frame, FAR_PALM_MM, TRULY_LOST_TIP_PX_AT_640};
-use digiteyes_host::eval::EvalReport;
+use digiteyes_host::bench::robustness::count_run;
 use digiteyes_host::eval::{evaluate, stats};
-use digiteyes_host::sequence::{read_states, Sequence};
 use digiteyes_host::track::track_sequence_opts;
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -90,7 +88,7 @@ fn main() -> Result<()> {
                     let r = track_sequence_opts(dir, &out, config, false, None, &options).and_then(
                         |_| {
                             let report = evaluate(dir, &out)?;
-                            let judged = judge(dir, &out, &report)?;
+                            let judged = count_run(dir, &out, &report)?;
                             Ok((report, judged))
                         },
                     );
@@ -128,7 +126,7 @@ fn main() -> Result<()> {
             let joint: Vec<f64> = g.iter().map(|r| r.2).collect();
             let tip: Vec<f64> = g.iter().map(|r| r.3).collect();
             let ge95 = life.iter().filter(|&&l| l >= 0.95).count() as f64 / life.len() as f64;
-            let far: usize = g.iter().map(|r| r.4.far).sum();
+            let far: usize = g.iter().map(|r| r.4.far_unflagged).sum();
             let both: usize = g.iter().map(|r| r.4.flagged_and_lost).sum();
             let flagged: usize = both + g.iter().map(|r| r.4.flagged_only).sum::<usize>();
             let truly: usize = both + g.iter().map(|r| r.4.lost_only).sum::<usize>();
@@ -191,40 +189,4 @@ fn sign_test(a: usize, b: usize) -> f64 {
         tail += choose;
     }
     (2.0 * tail / 2f64.powi(n as i32)).min(1.0)
-}
-
-/// What the lost flag and the palm did on a tracked seed, judged as the benchmark judges
-/// them: frames far from the hand and not flagged, and the lost flag against frames truly
-/// lost (flagged and lost, flagged only, lost only).
-#[derive(Debug, Clone, Copy, Default)]
-struct Judged {
-    far: usize,
-    flagged_and_lost: usize,
-    flagged_only: usize,
-    lost_only: usize,
-}
-
-/// [`Judged`] for the states at `out` of the sequence at `dir`, evaluated as `report`.
-fn judge(dir: &std::path::Path, out: &std::path::Path, report: &EvalReport) -> Result<Judged> {
-    let sequence = Sequence::open(dir)?;
-    let truth = sequence.read_truth()?;
-    let table = read_states(out, sequence.n_states())?;
-    let lost = table.extra("lost").unwrap_or_default();
-    let width = sequence.cameras.first().map_or(640, |c| c.width);
-    let tip_limit = TRULY_LOST_TIP_PX_AT_640 * f64::from(width) / 640.0;
-    let mut judged = Judged::default();
-    for (k, (q, t)) in table.rows.iter().zip(&truth.rows).enumerate() {
-        let (palm_mm, truly) = judge_frame(q, t, report, k, tip_limit);
-        let flagged = lost.get(k).is_some_and(|&v| v != 0.0);
-        match (flagged, truly) {
-            (true, true) => judged.flagged_and_lost += 1,
-            (true, false) => judged.flagged_only += 1,
-            (false, true) => judged.lost_only += 1,
-            (false, false) => {}
-        }
-        if !flagged && (palm_mm.is_nan() || palm_mm > FAR_PALM_MM) {
-            judged.far += 1;
-        }
-    }
-    Ok(judged)
 }

@@ -13,22 +13,11 @@ use digiteyes_core::estimator::{FreeMask, Robust};
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::sequence::Sequence;
-use digiteyes_host::{render_scenario, RenderOptions, TrackerConfig};
+use digiteyes_host::TrackerConfig;
 
 mod common;
-use common::{frames, hand_free::hand_free, search};
-
-fn render(dir: &std::path::Path, scenario: &str, seed: u64, frames: usize) -> Sequence {
-    let seq = dir.join(format!("{scenario}-{seed}"));
-    let options = RenderOptions {
-        seed,
-        frames: Some(frames),
-        size: Some((320, 240)),
-        ..RenderOptions::default()
-    };
-    render_scenario(scenario, &seq, &options).unwrap();
-    Sequence::open(&seq).unwrap()
-}
+use common::{frames, search};
+use digiteyes_host::render::hand_free::hand_free;
 
 /// A tracker and a finder for `sequence` from nothing: every state free, the base the
 /// identity palm at the origin.
@@ -51,7 +40,7 @@ fn finder(sequence: &Sequence, acquire: AcquireConfig, config: FinderConfig) -> 
 fn hand_free_frames_are_never_claimed() {
     let dir = tempfile::tempdir().unwrap();
     for (rig, seed) in [("random-mono", 101), ("random-stereo", 102)] {
-        let sequence = render(dir.path(), rig, seed, 1);
+        let sequence = common::seeded(dir.path(), rig, seed, 1);
         // The whole search, to the end, on every frame, and every leaf refined and judged by
         // the acceptance the finder uses.
         let acquire = AcquireConfig {
@@ -134,7 +123,7 @@ fn hand_free_frames_are_never_claimed() {
 fn the_search_keeps_its_budget_and_goes_on_where_it_left_off() {
     let dir = tempfile::tempdir().unwrap();
     for (rig, seed) in [("random-mono", 101), ("random-stereo", 102)] {
-        let sequence = render(dir.path(), rig, seed, 1);
+        let sequence = common::seeded(dir.path(), rig, seed, 1);
         let images = frames::images(&sequence, 0);
         let views = frames::views(&images);
         let config = AcquireConfig::default();
@@ -202,7 +191,7 @@ fn acquisition(
     tracker: TrackerConfig,
     finder: FinderConfig,
 ) -> (Vec<bool>, String) {
-    let sequence = render(dir, rig, seed, 34);
+    let sequence = common::seeded(dir, rig, seed, 34);
     let truth = sequence.read_truth().unwrap();
     let (mut auto, mut bufs) = search::searching_with(&sequence, AcquireConfig::default(), tracker);
     auto.set_finder(finder);
@@ -339,7 +328,7 @@ fn the_library_pose_that_scores_best_is_the_nearest_the_hand() {
     // the truth, 0.877; the fist and the pointing hand score lowest. Gauss-Newton refines
     // the chosen start before the acceptance judges it.)
     let dir = tempfile::tempdir().unwrap();
-    let sequence = render(dir.path(), "fullhand-stereo", 0, 1);
+    let sequence = common::seeded(dir.path(), "fullhand-stereo", 0, 1);
     let n = sequence.n_states();
     let truth: Vec<f32> = sequence.read_truth().unwrap().rows[0]
         .iter()

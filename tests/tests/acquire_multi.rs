@@ -14,19 +14,6 @@ use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::hypotheses::{HypothesesConfig, MultiTracker};
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
 use digiteyes_host::sequence::Sequence;
-use digiteyes_host::{render_scenario, RenderOptions};
-
-fn render(dir: &std::path::Path, scenario: &str, seed: u64, frames: usize) -> Sequence {
-    let seq = dir.join(format!("{scenario}-{seed}"));
-    let options = RenderOptions {
-        seed,
-        frames: Some(frames),
-        size: Some((320, 240)),
-        ..RenderOptions::default()
-    };
-    render_scenario(scenario, &seq, &options).unwrap();
-    Sequence::open(&seq).unwrap()
-}
 
 fn whole(q: &[f32]) -> [f32; MAX_STATES] {
     let mut out = [0.0f32; MAX_STATES];
@@ -120,7 +107,7 @@ fn seeded_hypotheses_start_fresh_are_capped_at_the_count_and_the_right_one_is_ke
 fn a_leaf_from_an_earlier_frame_is_placed_where_the_hand_is_now() {
     let dir = tempfile::tempdir().unwrap();
     for (rig, seed) in [("random-stereo", 101), ("random-mono", 102)] {
-        let sequence = render(dir.path(), rig, seed, 1);
+        let sequence = common::seeded(dir.path(), rig, seed, 1);
         let truth: Vec<f32> = sequence.read_truth().unwrap().rows[0]
             .iter()
             .map(|&v| v as f32)
@@ -149,7 +136,7 @@ fn a_leaf_from_an_earlier_frame_is_placed_where_the_hand_is_now() {
 #[test]
 fn the_local_variants_turn_and_move_the_last_good_state() {
     let dir = tempfile::tempdir().unwrap();
-    let sequence = render(dir.path(), "random-mono", 103, 1);
+    let sequence = common::seeded(dir.path(), "random-mono", 103, 1);
     let q: Vec<f32> = sequence.read_truth().unwrap().rows[0]
         .iter()
         .map(|&v| v as f32)
@@ -209,7 +196,7 @@ fn acquire(sequence: &Sequence, finder: FinderConfig, frames: usize) -> (usize, 
 fn an_accepted_leaf_is_confirmed_among_the_others_and_a_refuted_one_given_up() {
     let dir = tempfile::tempdir().unwrap();
     // A tuning seed the probe acquires.
-    let sequence = render(dir.path(), "random-stereo", 113, 24);
+    let sequence = common::seeded(dir.path(), "random-stereo", 113, 24);
     let confirm = FinderConfig {
         confirm_frames: 5,
         confirm_hypotheses: 4,

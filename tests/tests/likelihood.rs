@@ -4,26 +4,13 @@
 //! 30 mm or turned 40°, in at least 39 of 40 cases for smaller perturbations — and a frame
 //! without the hand scores the true state poorly.
 
-use std::path::Path;
-
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::{evaluate, EdgeMap, Likelihood, LikelihoodConfig};
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_host::sequence::Sequence;
-use digiteyes_host::{render_scenario, RenderOptions};
 
-fn render(dir: &Path, scenario: &str, seed: u64, frames: usize) -> Sequence {
-    let seq = dir.join(format!("{scenario}-{seed}"));
-    let options = RenderOptions {
-        frames: Some(frames),
-        size: Some((320, 240)),
-        seed,
-        ..RenderOptions::default()
-    };
-    render_scenario(scenario, &seq, &options).unwrap();
-    Sequence::open(&seq).unwrap()
-}
+mod common;
 
 fn score(sequence: &Sequence, k: usize, q: &[f32], blank: bool) -> Likelihood {
     let config = LikelihoodConfig::default();
@@ -75,7 +62,7 @@ fn the_true_state_scores_better_than_perturbed_ones() {
     let mut margins = Vec::new();
     let randoms = (0..8).map(|i| ("random-mono", 201 + 2 * i));
     for (scenario, seed) in [("fullhand-mono", 1)].into_iter().chain(randoms) {
-        let sequence = render(dir.path(), scenario, seed, 20);
+        let sequence = common::seeded(dir.path(), scenario, seed, 20);
         let truth = sequence.read_truth().unwrap();
         for k in [0, 10, 19] {
             let q: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
@@ -150,7 +137,7 @@ fn the_chamfer_summed_as_points_are_made_is_the_buffered_samples() {
     let mut with_hidden = 0;
     let mut with_outside = 0;
     for (scenario, seed) in [("fullhand-mono", 1), ("random-mono", 203)] {
-        let sequence = render(dir.path(), scenario, seed, 1);
+        let sequence = common::seeded(dir.path(), scenario, seed, 1);
         let truth = sequence.read_truth().unwrap();
         let q: Vec<f32> = truth.rows[0].iter().map(|&v| v as f32).collect();
         let image = sequence.read_frame(0, 0).unwrap();

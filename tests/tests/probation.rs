@@ -9,22 +9,10 @@ use digiteyes_core::acquire::{AcquireConfig, FinderConfig};
 use digiteyes_core::auto_tracker::{AutoReport, AutoTracker, Status};
 use digiteyes_core::frame::FrameView;
 use digiteyes_host::sequence::Sequence;
-use digiteyes_host::{render_scenario, RenderOptions};
 
 mod common;
-use common::{frames, hand_free, search};
-
-fn render(dir: &std::path::Path, scenario: &str, seed: u64, frames: usize) -> Sequence {
-    let seq = dir.join(format!("{scenario}-{seed}"));
-    let options = RenderOptions {
-        seed,
-        frames: Some(frames),
-        size: Some((320, 240)),
-        ..RenderOptions::default()
-    };
-    render_scenario(scenario, &seq, &options).unwrap();
-    Sequence::open(&seq).unwrap()
-}
+use common::{frames, search};
+use digiteyes_host::render::hand_free;
 
 fn step(auto: &mut AutoTracker, bufs: &mut [Vec<u8>], views: &[FrameView<'_>]) -> AutoReport {
     let mut b: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
@@ -72,7 +60,7 @@ fn hand_free_run(
 fn no_frame_of_1000_hand_free_ones_is_claimed() {
     let dir = tempfile::tempdir().unwrap();
     for (rig, seed) in [("random-mono", 1411), ("random-stereo", 1412)] {
-        let sequence = render(dir.path(), rig, seed, 1);
+        let sequence = common::seeded(dir.path(), rig, seed, 1);
         let (claims, accepted, refined) = hand_free_run(&sequence, FinderConfig::default(), 1000);
         println!(
             "{rig} {seed}: 1000 hand-free frames, leaves refined on {refined}, {accepted} \
@@ -108,7 +96,7 @@ fn no_frame_of_1000_hand_free_ones_is_claimed() {
 /// reports up to frame `last`, and the state reported after each.
 fn acquisition(replaced: Option<usize>, last: usize) -> (Vec<AutoReport>, Vec<Vec<f32>>) {
     let dir = tempfile::tempdir().unwrap();
-    let sequence = render(dir.path(), "random-stereo", 107, last + 1);
+    let sequence = common::seeded(dir.path(), "random-stereo", 107, last + 1);
     let (mut auto, mut bufs) = search::searching(&sequence, AcquireConfig::default());
     let sizes: Vec<(usize, usize)> = sequence
         .cameras

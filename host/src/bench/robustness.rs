@@ -159,6 +159,70 @@ pub fn judge_frame(
     (palm_mm, !within)
 }
 
+/// The frames of a tracked run, judged against the truth by [`judge_frame`]: the lost flag
+/// against the frames truly lost, and the frames far from the hand and not flagged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct FrameCounts {
+    /// Flagged lost and truly lost.
+    pub flagged_and_lost: usize,
+    /// Flagged lost, not truly lost.
+    pub flagged_only: usize,
+    /// Truly lost, not flagged.
+    pub lost_only: usize,
+    /// Not flagged, the palm over [`FAR_PALM_MM`] from the truth (or not a number).
+    pub far_unflagged: usize,
+    /// The first truly lost frame, if any.
+    pub first_truly_lost: Option<usize>,
+}
+
+/// [`FrameCounts`] of the estimated states `rows` against `truth`, with the `lost` column
+/// (nonzero: flagged; a missing value: not flagged), the fingertip errors of `report` and
+/// the truly-lost limit `tip_limit_px`.
+pub fn count_frames(
+    rows: &[Vec<f64>],
+    truth: &[Vec<f64>],
+    lost: &[f64],
+    report: &EvalReport,
+    tip_limit_px: f64,
+) -> FrameCounts {
+    let mut counts = FrameCounts::default();
+    for (k, (estimate, true_state)) in rows.iter().zip(truth).enumerate() {
+        let (palm_mm, truly) = judge_frame(estimate, true_state, report, k, tip_limit_px);
+        let flagged = lost.get(k).is_some_and(|&v| v != 0.0);
+        match (flagged, truly) {
+            (true, true) => counts.flagged_and_lost += 1,
+            (true, false) => counts.flagged_only += 1,
+            (false, true) => counts.lost_only += 1,
+            (false, false) => {}
+        }
+        if truly && counts.first_truly_lost.is_none() {
+            counts.first_truly_lost = Some(k);
+        }
+        if !flagged && (palm_mm.is_nan() || palm_mm > FAR_PALM_MM) {
+            counts.far_unflagged += 1;
+        }
+    }
+    counts
+}
+
+/// [`count_frames`] of the states CSV `states` written for the sequence at `seq`, evaluated
+/// as `report` (by [`evaluate`]), at the sequence's first camera's width.
+pub fn count_run(seq: &Path, states: &Path, report: &EvalReport) -> Result<FrameCounts> {
+    let sequence = Sequence::open(seq)?;
+    let truth = sequence.read_truth()?;
+    let table = crate::sequence::read_states(states, sequence.n_states())?;
+    let lost = table.extra("lost").unwrap_or_default();
+    let width = sequence.cameras.first().map_or(640, |c| c.width);
+    let tip_limit = TRULY_LOST_TIP_PX_AT_640 * f64::from(width) / 640.0;
+    Ok(count_frames(
+        &table.rows,
+        &truth.rows,
+        &lost,
+        report,
+        tip_limit,
+    ))
+}
+
 /// Renders, tracks and judges seed `seed` in `dir`.
 pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResult> {
     let stereo = seed.is_multiple_of(2);
@@ -211,23 +275,12 @@ pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResu
         ms_per_frame: 1e3 * summary.tracking_seconds / summary.frames.max(1) as f64,
         iterations_per_frame: stats::mean(&iterations),
     };
-    for (k, (estimate, true_state)) in table.table.rows.iter().zip(&truth.rows).enumerate() {
-        let (palm_mm, truly) = judge_frame(estimate, true_state, &report, k, tip_limit);
-        let flagged = lost.get(k).is_some_and(|&v| v != 0.0);
-        match (flagged, truly) {
-            (true, true) => result.lost_flagged_and_true += 1,
-            (true, false) => result.lost_flagged_only += 1,
-            (false, true) => result.lost_true_only += 1,
-            (false, false) => {}
-        }
-        if truly && result.first_truly_lost.is_none() {
-            result.first_truly_lost = Some(k);
-        }
-        let far = palm_mm.is_nan() || palm_mm > FAR_PALM_MM;
-        if !flagged && far {
-            result.far_unflagged += 1;
-        }
-    }
+    let counts = count_frames(&table.table.rows, &truth.rows, &lost, &report, tip_limit);
+    result.lost_flagged_and_true = counts.flagged_and_lost;
+    result.lost_flagged_only = counts.flagged_only;
+    result.lost_true_only = counts.lost_only;
+    result.far_unflagged = counts.far_unflagged;
+    result.first_truly_lost = counts.first_truly_lost;
     if let (Some(gallery), Some(k)) = (&args.gallery, result.first_truly_lost) {
         let state: Vec<f32> = table.table.rows[k].iter().map(|&v| v as f32).collect();
         for (c, camera) in sequence.cameras.iter().enumerate() {

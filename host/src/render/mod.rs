@@ -10,6 +10,7 @@
 
 pub mod background;
 pub mod filter;
+pub mod hand_free;
 pub mod intersect;
 pub mod lighting;
 pub mod scene;

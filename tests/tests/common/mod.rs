@@ -3,11 +3,11 @@
 
 pub mod browser;
 pub mod frames;
-pub mod hand_free;
 pub mod search;
 
 use std::path::{Path, PathBuf};
 
+use digiteyes_host::sequence::Sequence;
 use digiteyes_host::{render_scenario, RenderOptions};
 
 /// A short `mouse` sequence at 320×240 in `dir/mouse` (quick to render, upload and track).
@@ -21,6 +21,20 @@ pub fn mouse(dir: &Path, frames: usize) -> PathBuf {
     };
     render_scenario("mouse", &seq, &options).unwrap();
     seq
+}
+
+/// `scenario` rendered with `seed`, `frames` frames at 320×240, in `dir/{scenario}-{seed}`,
+/// opened (quick enough for debug builds).
+pub fn seeded(dir: &Path, scenario: &str, seed: u64, frames: usize) -> Sequence {
+    let seq = dir.join(format!("{scenario}-{seed}"));
+    let options = RenderOptions {
+        seed,
+        frames: Some(frames),
+        size: Some((320, 240)),
+        ..RenderOptions::default()
+    };
+    render_scenario(scenario, &seq, &options).unwrap();
+    Sequence::open(&seq).unwrap()
 }
 
 /// A test that cannot run here (a tool missing). Outside CI it prints `SKIPPED: …` straight to

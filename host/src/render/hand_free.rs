@@ -1,5 +1,7 @@
-//! Frames without a hand: plain, noisy or cluttered backgrounds, from a small deterministic
-//! generator (the search must never claim a hand on them).
+//! Frames with no hand in them: the background's grey, optional noise, optional clutter
+//! (bright and dark bars at every angle), from a small deterministic generator. The search
+//! must never claim a hand on them (`tests/tests/probation.rs`, `acquire_probe
+//! --hand-free-status`).
 
 /// A hand-free frame: the background's grey, optional noise, optional clutter (bright and
 /// dark bars at every angle), from a small deterministic generator.
