@@ -136,6 +136,9 @@ struct Args {
     /// The tracker's outermost-edge share (0: the strongest edge; default: the tracker's).
     #[arg(long)]
     outermost_share: Option<f32>,
+    /// The tracker's Gauss–Newton iterations per frame (default: the tracker's).
+    #[arg(long)]
+    tracker_iterations: Option<u8>,
     /// Write every refined leaf's judgement and true error here (CSV).
     #[arg(long)]
     leaves_csv: Option<std::path::PathBuf>,
@@ -164,7 +167,10 @@ struct Args {
     /// count as right.
     #[arg(long, default_value_t = 10.0)]
     limit_px: f32,
-    /// Print the best hypothesis' score and tip error on frames with several hypotheses.
+    /// Print the best hypothesis' score and tip error on frames with several hypotheses; on
+    /// every claimed frame the claim against the truth (both scored, the palm's offset and
+    /// turn, the turn from the truth's depth-flipped reading, each finger's joint RMS); and
+    /// the truth's own score every 10th frame.
     #[arg(long)]
     trace: bool,
     /// The blackout sweep instead: render frames A..B without the hand, track from the
@@ -245,6 +251,9 @@ static TRACKER_ANGLE_DEG: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
 /// The tracker's outermost-edge share, when `--outermost-share` gives one (set once in `main`).
 static TRACKER_OUTERMOST: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
 
+/// The tracker's iterations, when `--tracker-iterations` gives them (set once in `main`).
+static TRACKER_ITERATIONS: std::sync::OnceLock<u8> = std::sync::OnceLock::new();
+
 /// The tracker's defaults, with `--angle-deg` and `--outermost-share` if given.
 fn tracker_config() -> TrackerConfig {
     let mut config = TrackerConfig::default();
@@ -253,6 +262,9 @@ fn tracker_config() -> TrackerConfig {
     }
     if let Some(share) = TRACKER_OUTERMOST.get() {
         config.features.outermost_share = *share;
+    }
+    if let Some(iterations) = TRACKER_ITERATIONS.get() {
+        config.iterations = *iterations;
     }
     config
 }
@@ -343,6 +355,83 @@ fn fine_columns(sequence: &Sequence, views: &[FrameView<'_>], q: &[f32]) -> Resu
         out.push_str(&format!(",{mean:.4},{worst:.4}"));
     }
     Ok(out)
+}
+
+/// How a claimed state `q` differs from the truth: the search's likelihood of each (mean,
+/// worst camera), the palm's offset (mm) and turn (deg), the joints' RMS (deg).
+fn claim_against_truth(
+    sequence: &Sequence,
+    views: &[FrameView<'_>],
+    q: &[f32],
+    truth: &[f32],
+    acquire: &AcquireConfig,
+) -> Result<String> {
+    let mut bufs = buffers(&sequence.cameras, acquire);
+    let maps = edge_maps(&mut bufs, views, acquire)?;
+    let mut scorer = StateScorer::new();
+    let mut score = |s: &[f32]| {
+        scorer.score_cameras(
+            &sequence.model,
+            &sequence.cameras,
+            views,
+            &maps,
+            s,
+            &acquire.likelihood,
+        )
+    };
+    let (claim_mean, claim_worst) = score(q);
+    let (truth_mean, truth_worst) = score(truth);
+    let palm_mm = (4..7).map(|i| (q[i] - truth[i]).powi(2)).sum::<f32>().sqrt();
+    let turn_deg = digiteyes_core::quaternion::angle_between(
+        [q[0], q[1], q[2], q[3]],
+        [truth[0], truth[1], truth[2], truth[3]],
+    )
+    .to_degrees();
+    let joints = &q[7..q.len().min(truth.len())];
+    let joint_rms_deg = (joints
+        .iter()
+        .zip(&truth[7..])
+        .map(|(a, b)| (a - b).powi(2))
+        .sum::<f32>()
+        / joints.len().max(1) as f32)
+        .sqrt()
+        .to_degrees();
+    let flip_deg = digiteyes_core::quaternion::angle_between(
+        [q[0], q[1], q[2], q[3]],
+        depth_flipped(&sequence.cameras[0], truth),
+    )
+    .to_degrees();
+    let offset: Vec<String> = (4..7).map(|i| format!("{:.0}", q[i] - truth[i])).collect();
+    let fingers: Vec<String> = [7..11, 11..15, 15..19, 19..23, 23..28]
+        .into_iter()
+        .filter(|r| r.end <= q.len().min(truth.len()))
+        .map(|r| {
+            let n = r.len() as f32;
+            let rms = (r.map(|i| (q[i] - truth[i]).powi(2)).sum::<f32>() / n).sqrt();
+            format!("{:.0}", rms.to_degrees())
+        })
+        .collect();
+    Ok(format!(
+        "claim {claim_mean:.3}/{claim_worst:.3} truth {truth_mean:.3}/{truth_worst:.3} \
+         palm {palm_mm:.1} mm ({}) turn {turn_deg:.1} deg (flip {flip_deg:.1}) joints {joint_rms_deg:.1} deg \
+         fingers {}",
+        offset.join(","),
+        fingers.join("/")
+    ))
+}
+
+/// The palm's rotation of `q` mirrored in depth as `camera` sees it: reflected through the
+/// plane across the camera's ray to the palm, and through the palm's own plane (so it stays a
+/// rotation) — the reading one view can hardly tell from `q`.
+fn depth_flipped(camera: &Camera, q: &[f32]) -> [f32; 4] {
+    use nalgebra::{Matrix3, Vector3};
+    let world = digiteyes_core::quaternion::rotation(q[0], q[1], q[2], q[3]);
+    let centre = camera.r * Vector3::new(q[4], q[5], q[6]) + camera.t;
+    let ray = centre.normalize();
+    let across_ray = Matrix3::identity() - 2.0 * ray * ray.transpose();
+    let across_palm = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0));
+    let flipped = camera.r.transpose() * across_ray * camera.r * world * across_palm;
+    digiteyes_core::quaternion::from_rotation(&flipped)
 }
 
 /// Edge maps of `views` in `buffers`.
@@ -513,6 +602,29 @@ fn run(
             }
         }
         line.push(status_char(&report, was));
+        if args.trace && k % 10 == 0 {
+            let images = read_frames(sequence, k)?;
+            let views: Vec<_> = images
+                .iter()
+                .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
+                .collect::<Result<_, _>>()?;
+            eprintln!(
+                "truth {label} {k} {}",
+                claim_against_truth(sequence, &views, &truth_k, &truth_k, &acquire)?
+            );
+        }
+        if args.trace && claimed {
+            let images = read_frames(sequence, k)?;
+            let views: Vec<_> = images
+                .iter()
+                .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
+                .collect::<Result<_, _>>()?;
+            eprintln!(
+                "claim {label} {k} tip {e:.1} px {} hypotheses {}",
+                claim_against_truth(sequence, &views, auto.state(), &truth_k, &acquire)?,
+                report.hypotheses
+            );
+        }
         if args.trace && report.hypotheses > 1 {
             eprintln!(
                 "trace {label} {k} {} {:.4} {e:.2}",
@@ -832,6 +944,9 @@ fn main() -> Result<()> {
     }
     if let Some(share) = args.outermost_share {
         let _ = TRACKER_OUTERMOST.set(share);
+    }
+    if let Some(iterations) = args.tracker_iterations {
+        let _ = TRACKER_ITERATIONS.set(iterations);
     }
     if let Some(dark) = args.blackout.clone() {
         return blackout_sweep(&args, &dark);
