@@ -607,6 +607,8 @@ impl AutoTracker {
             spawn_per_frame: 0,
             keep_fingers: false,
             score_every_frames: 1,
+            switch_margin: finder.confirm_switch_margin,
+            score_memory: finder.confirm_score_memory,
             ..self.hypotheses
         });
         self.multi.seed(others)?;

@@ -113,6 +113,12 @@ struct Args {
     /// hand is claimed (negative: claimed on the accepting frame).
     #[arg(long, allow_hyphen_values = true)]
     probation_drop: Option<f32>,
+    /// While confirming, how much more another hypothesis must score to replace the best.
+    #[arg(long)]
+    confirm_switch: Option<f32>,
+    /// While confirming, how much of each hypothesis' past scores its rank keeps.
+    #[arg(long)]
+    confirm_memory: Option<f32>,
     /// How far the local re-acquisition moves the palm in depth with one camera (a share).
     #[arg(long)]
     local_depth_mono: Option<f32>,
@@ -241,6 +247,8 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             f.local_depth_share[0],
             args.local_depth_mono.unwrap_or(f.local_depth_share[1]),
         ],
+        confirm_switch_margin: args.confirm_switch.unwrap_or(f.confirm_switch_margin),
+        confirm_score_memory: args.confirm_memory.unwrap_or(f.confirm_score_memory),
     };
     (acquire, finder)
 }
@@ -381,7 +389,10 @@ fn claim_against_truth(
     };
     let (claim_mean, claim_worst) = score(q);
     let (truth_mean, truth_worst) = score(truth);
-    let palm_mm = (4..7).map(|i| (q[i] - truth[i]).powi(2)).sum::<f32>().sqrt();
+    let palm_mm = (4..7)
+        .map(|i| (q[i] - truth[i]).powi(2))
+        .sum::<f32>()
+        .sqrt();
     let turn_deg = digiteyes_core::quaternion::angle_between(
         [q[0], q[1], q[2], q[3]],
         [truth[0], truth[1], truth[2], truth[3]],
@@ -626,9 +637,24 @@ fn run(
             );
         }
         if args.trace && report.hypotheses > 1 {
+            let each: Vec<String> = auto
+                .hypotheses()
+                .iter()
+                .map(|h| {
+                    let tip = tip_error_px(
+                        &sequence.model,
+                        &sequence.cameras,
+                        &h.memory.state,
+                        &truth_k,
+                    );
+                    format!("{:.3}:{tip:.1}", h.score)
+                })
+                .collect();
             eprintln!(
-                "trace {label} {k} {} {:.4} {e:.2}",
-                report.hypotheses, report.best_score
+                "trace {label} {k} {} {:.4} {e:.2} [{}]",
+                report.hypotheses,
+                report.best_score,
+                each.join(" ")
             );
         }
         if claimed && out.first_claim.is_none() {

@@ -81,6 +81,16 @@ pub struct FinderConfig {
     /// one: a palm moved 15 % nearer was refined, accepted and held there, 90 mm from the
     /// hand and never flagged (measured: `docs/recovery.md`).
     pub local_depth_share: [f32; 2],
+    /// While confirming, another hypothesis replaces the best when its ranked score is this
+    /// much more (likelihood units; default 0: the running mean below already keeps the
+    /// output from flickering; the tracker's hypotheses use
+    /// [`HypothesesConfig::switch_margin`](crate::hypotheses::HypothesesConfig::switch_margin)).
+    pub confirm_switch_margin: f32,
+    /// While confirming, how much of each hypothesis' past scores its rank keeps (default
+    /// 0.6; [`HypothesesConfig::score_memory`](crate::hypotheses::HypothesesConfig::score_memory)):
+    /// near leaves differ by less than a frame's noise on any one frame, and the one better
+    /// over the confirming frames is the hand more often than the one better on the last.
+    pub confirm_score_memory: f32,
 }
 
 impl Default for FinderConfig {
@@ -102,6 +112,8 @@ impl Default for FinderConfig {
             local_frames_in_view: 8,
             probation_max_drop: Some(0.10),
             local_depth_share: [0.15, 0.0],
+            confirm_switch_margin: 0.0,
+            confirm_score_memory: 0.6,
         }
     }
 }

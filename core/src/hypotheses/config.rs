@@ -61,6 +61,11 @@ pub struct HypothesesConfig {
     pub switch_margin: f32,
     /// Taken off the score of a hypothesis whose frame the tracker flagged lost.
     pub lost_penalty: f32,
+    /// How much of a carried hypothesis' past scores its rank keeps, 0..=1: each scored
+    /// frame its ranked score becomes `memory × past + (1 − memory) × score` (0: ranked by
+    /// this frame's score alone). A frame's score is noisy by about 0.005 between near
+    /// readings; a hypothesis better over several frames is the one to keep.
+    pub score_memory: f32,
     /// The hypotheses are scored, sampled around and merged on one frame in this many
     /// (0 and 1: every frame), and on every frame after one whose best the tracker flagged
     /// lost; on the frames between, each is only tracked, keeping its rank and last score.
@@ -98,6 +103,7 @@ impl Default for HypothesesConfig {
             merge_distance: 0.3,
             switch_margin: 0.01,
             lost_penalty: 0.2,
+            score_memory: 0.0,
             score_every_frames: 1,
             likelihood: LikelihoodConfig::default(),
         }

@@ -21,6 +21,7 @@
 pub mod config;
 pub mod fingers;
 pub mod merge;
+mod rank;
 pub mod score;
 pub mod weak;
 
@@ -46,6 +47,9 @@ pub struct Hypothesis {
     pub report: FrameReport,
     /// The likelihood score of its last frame, less the lost penalty (0 with one hypothesis).
     pub score: f32,
+    /// The score as ranked: its running mean over the frames it was scored on, the past
+    /// weighted by [`HypothesesConfig::score_memory`] (`None` until first scored).
+    pub ranked_score: Option<f32>,
     /// Frames it has been carried (0 when sampled on this frame).
     pub age: u32,
 }
@@ -57,6 +61,7 @@ impl Hypothesis {
             memory,
             report: FrameReport::default(),
             score: 0.0,
+            ranked_score: None,
             age: 0,
         }
     }
@@ -296,6 +301,7 @@ impl MultiTracker {
                     memory: kept,
                     report,
                     score: 0.0,
+                    ranked_score: None,
                     age: 0,
                 });
             }
@@ -303,6 +309,7 @@ impl MultiTracker {
                 memory,
                 report,
                 score: 0.0,
+                ranked_score: h.ranked_score,
                 age: h.age + 1,
             });
         }
@@ -324,6 +331,7 @@ impl MultiTracker {
                 memory,
                 report,
                 score: 0.0,
+                ranked_score: None,
                 age: 0,
             });
         }
@@ -341,11 +349,16 @@ impl MultiTracker {
                 score -= self.config.lost_penalty;
             }
             c.score = score;
+            c.ranked_score = Some(rank::ranked_score(
+                c.ranked_score,
+                score,
+                self.config.score_memory,
+            ));
         }
         // 4. Merge and keep; the previous best keeps its place unless clearly beaten.
         let mut ranking = [0.0f32; MAX_CANDIDATES];
         for (r, c) in ranking.iter_mut().zip(&candidates) {
-            *r = c.score;
+            *r = c.ranked_score.unwrap_or(c.score);
         }
         if let Some(r) = ranking.first_mut() {
             *r += self.config.switch_margin;
