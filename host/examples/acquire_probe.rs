@@ -25,6 +25,9 @@
 use std::io::Write;
 use std::ops::RangeInclusive;
 
+#[path = "common/kept.rs"]
+mod kept;
+
 use anyhow::{anyhow, Result};
 use clap::Parser;
 use digiteyes_core::acquire::{
@@ -518,13 +521,6 @@ fn auto_tracker(sequence: &Sequence, args: &Args, initial: Option<&[f32]>) -> Re
     Ok(auto)
 }
 
-/// Frame `k` of every camera.
-fn read_frames(sequence: &Sequence, k: usize) -> Result<Vec<image::GrayImage>> {
-    (0..sequence.cameras.len())
-        .map(|c| sequence.read_frame(c, k))
-        .collect()
-}
-
 /// One frame through the status machine: its report, whether it claims the hand, and the
 /// claimed state's tip error (infinite when not claimed).
 fn step_frame(
@@ -534,11 +530,8 @@ fn step_frame(
     k: usize,
     truth_k: &[f32],
 ) -> Result<(digiteyes_core::auto_tracker::AutoReport, bool, f32)> {
-    let images = read_frames(sequence, k)?;
-    let views: Vec<_> = images
-        .iter()
-        .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
-        .collect::<Result<_, _>>()?;
+    let images = kept::read_instant(sequence, k)?;
+    let views = kept::views(&images)?;
     let mut buffers: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
     let report = auto
         .step(&views, &mut buffers)
@@ -596,11 +589,8 @@ fn run(
             if let (Some((verdict, q)), Some(f)) = (auto.finder().last_leaf(), csv.as_mut()) {
                 let n = sequence.n_states();
                 let e = tip_error_px(&sequence.model, &sequence.cameras, &q[..n], &truth_k);
-                let images = read_frames(sequence, k)?;
-                let views: Vec<_> = images
-                    .iter()
-                    .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
-                    .collect::<Result<_, _>>()?;
+                let images = kept::read_instant(sequence, k)?;
+                let views = kept::views(&images)?;
                 let fine = fine_columns(sequence, &views, &q[..n])?;
                 writeln!(
                     f,
@@ -613,28 +603,22 @@ fn run(
             }
         }
         line.push(status_char(&report, was));
-        if args.trace && k % 10 == 0 {
-            let images = read_frames(sequence, k)?;
-            let views: Vec<_> = images
-                .iter()
-                .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
-                .collect::<Result<_, _>>()?;
-            eprintln!(
-                "truth {label} {k} {}",
-                claim_against_truth(sequence, &views, &truth_k, &truth_k, &acquire)?
-            );
-        }
-        if args.trace && claimed {
-            let images = read_frames(sequence, k)?;
-            let views: Vec<_> = images
-                .iter()
-                .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
-                .collect::<Result<_, _>>()?;
-            eprintln!(
-                "claim {label} {k} tip {e:.1} px {} hypotheses {}",
-                claim_against_truth(sequence, &views, auto.state(), &truth_k, &acquire)?,
-                report.hypotheses
-            );
+        if args.trace && (k % 10 == 0 || claimed) {
+            let images = kept::read_instant(sequence, k)?;
+            let views = kept::views(&images)?;
+            if k % 10 == 0 {
+                eprintln!(
+                    "truth {label} {k} {}",
+                    claim_against_truth(sequence, &views, &truth_k, &truth_k, &acquire)?
+                );
+            }
+            if claimed {
+                eprintln!(
+                    "claim {label} {k} tip {e:.1} px {} hypotheses {}",
+                    claim_against_truth(sequence, &views, auto.state(), &truth_k, &acquire)?,
+                    report.hypotheses
+                );
+            }
         }
         if args.trace && report.hypotheses > 1 {
             let each: Vec<String> = auto
@@ -821,10 +805,7 @@ fn oracle_holds(sequence: &Sequence, start: usize, limit: f32) -> Result<bool> {
         let images: Vec<_> = (0..sequence.cameras.len())
             .map(|c| sequence.read_frame(c, k))
             .collect::<Result<_>>()?;
-        let views: Vec<_> = images
-            .iter()
-            .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
-            .collect::<Result<_, _>>()?;
+        let views = kept::views(&images)?;
         let report = tracker.track(&views).map_err(|e| anyhow!("{e}"))?;
         let t: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
         let e = tip_error_px(&sequence.model, &sequence.cameras, tracker.state(), &t);

@@ -3,7 +3,9 @@
 //! `default` or `key=value` overrides joined by `+` (keys: `pj`, `pt`, `pq` the prior's
 //! weights; `sj`, `st`, `sq` the conditioning; `iters`, `predict`, `window`, `slices`,
 //! `palm`, `palmw`, `tipw`, `fvf`, `outer`; `angle` the edge-direction limit in degrees (90:
-//! off); `huber`, `tukey` the robust kernel's px; `k`, `s`, `spawn` the hypotheses; `watch`
+//! off); `huber`, `tukey` the robust kernel's px; `k`, `s`, `spawn`, `smem`, `switch` the
+//! hypotheses (their count, scoring period, samples, score memory, switch margin); `csmem`,
+//! `cswitch` the confirm phase's score memory and switch margin; `watch`
 //! its period, `drop` its bar; `depth1` one camera's local depth share; `probation` the acceptance's
 //! probation drop, negative: off). Each group's row also gives
 //! its frames far from the hand and not flagged (`far`) and the lost flag's precision and

@@ -8,7 +8,7 @@ use common::frames::{images, views};
 use common::search;
 
 use digiteyes_core::acquire::{AcquireConfig, FinderConfig, LOCAL_VARIANTS};
-use digiteyes_core::auto_tracker::Status;
+use digiteyes_core::auto_tracker::{AutoReport, AutoTracker, Status};
 use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::hypotheses::{HypothesesConfig, MultiTracker};
@@ -171,24 +171,37 @@ fn the_local_variants_turn_and_move_the_last_good_state() {
     }
 }
 
+/// Searches `sequence` from nothing under `finder` for its first `frames` frames, handing
+/// each frame's number, report and tracker to `each`.
+fn search_frames(
+    sequence: &Sequence,
+    finder: FinderConfig,
+    frames: usize,
+    mut each: impl FnMut(usize, &AutoReport, &AutoTracker),
+) {
+    let (mut auto, mut bufs) = search::searching(sequence, AcquireConfig::default());
+    auto.set_finder(finder);
+    for k in 0..frames.min(sequence.frames) {
+        let images = images(sequence, k);
+        let mut b: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
+        let r = auto.step(&views(&images), &mut b).unwrap();
+        each(k, &r, &auto);
+    }
+}
+
 /// The first frame of `sequence` the auto tracker accepts the hand on (claimed on the next,
 /// once confirmed: `FinderConfig::probation_max_drop`), and the status and hypotheses of the
 /// next `frames` frames.
 fn acquire(sequence: &Sequence, finder: FinderConfig, frames: usize) -> (usize, Vec<(Status, u8)>) {
-    let (mut auto, mut bufs) = search::searching(sequence, AcquireConfig::default());
-    auto.set_finder(finder);
     let mut found = None;
     let mut after = Vec::new();
-    for k in 0..sequence.frames {
-        let images = images(sequence, k);
-        let mut b: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
-        let r = auto.step(&views(&images), &mut b).unwrap();
+    search_frames(sequence, finder, sequence.frames, |k, r, auto| {
         if found.is_none() && r.accepted {
             found = Some(k);
         } else if found.is_some() && after.len() < frames {
             after.push((r.status, auto.hypotheses().len() as u8));
         }
-    }
+    });
     (found.expect("the hand is acquired"), after)
 }
 
@@ -232,7 +245,7 @@ fn an_accepted_leaf_is_confirmed_among_the_others_and_a_refuted_one_given_up() {
     assert_eq!(after[5].0, Status::Searching, "searching again: {after:?}");
 }
 
-/// The mean fingertip error (px) of the state claimed on each of frames `from..to` of
+/// The mean fingertip error (px) of the state claimed on each of frames `frames` of
 /// `sequence`, searched for from nothing under `finder` (infinite where no hand is claimed).
 fn claimed_tip_errors(
     sequence: &Sequence,
@@ -240,13 +253,8 @@ fn claimed_tip_errors(
     frames: std::ops::Range<usize>,
 ) -> Vec<f32> {
     let truth = sequence.read_truth().unwrap();
-    let (mut auto, mut bufs) = search::searching(sequence, AcquireConfig::default());
-    auto.set_finder(finder);
     let mut errors = Vec::new();
-    for k in 0..frames.end {
-        let images = images(sequence, k);
-        let mut b: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
-        let r = auto.step(&views(&images), &mut b).unwrap();
+    search_frames(sequence, finder, frames.end, |k, r, auto| {
         if frames.contains(&k) {
             let t: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
             errors.push(if r.status == Status::Tracking && !r.report.lost {
@@ -255,7 +263,7 @@ fn claimed_tip_errors(
                 f32::INFINITY
             });
         }
-    }
+    });
     errors
 }
 
