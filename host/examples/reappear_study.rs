@@ -1,0 +1,160 @@
+//! When does a tracked finger go wrong: while the cameras see it, while it is hidden, or just
+//! after it comes back into view? On the sequences `bench robustness --keep DIR` kept (their
+//! truth, cameras and the tracked `states.csv`), each finger's tip error (mean over the
+//! cameras, px) is followed frame by frame, and so is whether the truth's distal link of that
+//! finger is seen by some camera (`common/seen.rs`: a point of its axis inside the frame and
+//! not hidden by a nearer part of the hand).
+//!
+//! A finger's *onset* is a frame at which its tip error rises over the limit and stays over it
+//! for the next frames, while the palm is still within its limit (a finger going wrong, not
+//! the hand). Each frame at which the finger is within the limit is *at risk*, and is put in
+//! one of three classes by the finger's visibility: hidden now; seen now but hidden in one of
+//! the last `window` frames (just back in view); seen throughout. The onsets per at-risk frame
+//! of each class say where fingers are lost.
+//!
+//! ```text
+//! digiteyes bench robustness --seeds 60 --frames 200 --keep /tmp/keep
+//! cargo run --release -p digiteyes-host --example reappear_study -- /tmp/keep [--window 10]
+//! ```
+
+use std::path::PathBuf;
+
+use anyhow::{ensure, Result};
+use clap::Parser;
+use digiteyes_core::kinematics::Poses;
+use digiteyes_core::projection::ProjectedModel;
+use digiteyes_host::eval::reprojection_error;
+use digiteyes_host::sequence::{read_states, Sequence};
+
+#[path = "common/kept.rs"]
+mod kept;
+#[path = "common/seen.rs"]
+mod seen;
+
+#[derive(Parser)]
+struct Args {
+    /// Folders of kept seeds (`seedNNNN/`), as `bench robustness --keep` writes.
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    /// Frames back a finger counts as just back in view after being hidden.
+    #[arg(long, default_value_t = 10)]
+    window: usize,
+    /// A finger's tip error over this is wrong (px at the frame's own width).
+    #[arg(long, default_value_t = 20.0)]
+    limit_px: f64,
+    /// Frames the error must stay over the limit for an onset.
+    #[arg(long, default_value_t = 5)]
+    hold: usize,
+    /// The palm's limit (mm): onsets with the palm farther off are the hand's, not a finger's.
+    #[arg(long, default_value_t = 30.0)]
+    palm_mm: f64,
+}
+
+/// The three classes of an at-risk frame.
+const CLASSES: [&str; 3] = ["hidden now", "back in view", "seen throughout"];
+
+/// Per frame: each finger's tip error (px, mean over cameras), whether its distal link is
+/// seen, and the palm's error (mm).
+struct Frame {
+    tip_px: Vec<f64>,
+    seen: Vec<bool>,
+    palm_mm: f64,
+}
+
+fn frames(dir: &std::path::Path) -> Result<Vec<Frame>> {
+    let sequence = Sequence::open(dir)?;
+    let model = &sequence.model;
+    let n = sequence.n_states();
+    let truth = kept::f32s(&sequence.read_truth()?.rows);
+    let tracked = kept::f32s(&read_states(&dir.join("states.csv"), n)?.rows);
+    let mut view = ProjectedModel::default();
+    let mut out = Vec::new();
+    for (t, e) in truth.iter().zip(&tracked) {
+        let (pt, pe) = (Poses::compute(model, t)?, Poses::compute(model, e)?);
+        let joints_seen = seen::joints(&sequence, &pt, 1);
+        let mut tip_px: Vec<f64> = Vec::new();
+        let mut seen = Vec::new();
+        for (c, camera) in sequence.cameras.iter().enumerate() {
+            view.update(model, &pt, camera, 0.0);
+            for (f, link) in view.links.iter().filter(|l| l.distal).enumerate() {
+                let error = reprojection_error(camera, &pt, &pe, usize::from(link.child));
+                if c == 0 {
+                    tip_px.push(0.0);
+                    // The distal link's own joint: the last state of its chain.
+                    let last = model
+                        .chain(usize::from(link.frame))
+                        .and_then(|chain| chain.last().copied())
+                        .map(usize::from);
+                    seen.push(last.is_some_and(|s| joints_seen[s]));
+                }
+                if let Some(v) = tip_px.get_mut(f) {
+                    *v += error / sequence.cameras.len() as f64;
+                }
+            }
+        }
+        let palm_mm = (4..7)
+            .map(|i| f64::from(t[i] - e[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        out.push(Frame {
+            tip_px,
+            seen,
+            palm_mm,
+        });
+    }
+    Ok(out)
+}
+
+fn main() -> Result<()> {
+    let args = Args::parse();
+    ensure!(args.hold >= 1, "--hold must be at least 1");
+    // Per group (stereo 0, mono 1), per class: at-risk frames and onsets.
+    let mut at_risk = [[0usize; 3]; 2];
+    let mut onsets = [[0usize; 3]; 2];
+    for base in &args.dirs {
+        for dir in kept::seed_dirs(base)? {
+            let seed: u64 = dir
+                .file_name()
+                .and_then(|n| n.to_str())
+                .and_then(|n| n.trim_start_matches("seed").parse().ok())
+                .unwrap_or(0);
+            let g = (seed % 2) as usize;
+            let f = frames(&dir)?;
+            let fingers = f.first().map_or(0, |f| f.tip_px.len());
+            for finger in 0..fingers {
+                for k in 1..f.len().saturating_sub(args.hold) {
+                    if f[k - 1].tip_px[finger] > args.limit_px {
+                        continue;
+                    }
+                    let class = if !f[k].seen[finger] {
+                        0
+                    } else if (k.saturating_sub(args.window)..k).any(|j| !f[j].seen[finger]) {
+                        1
+                    } else {
+                        2
+                    };
+                    at_risk[g][class] += 1;
+                    let onset = (k..k + args.hold).all(|j| f[j].tip_px[finger] > args.limit_px)
+                        && f[k].palm_mm <= args.palm_mm;
+                    if onset {
+                        onsets[g][class] += 1;
+                    }
+                }
+            }
+        }
+    }
+    for (g, name) in [(1, "mono"), (0, "stereo")] {
+        let total: usize = onsets[g].iter().sum();
+        println!("{name}: {total} finger onsets");
+        for (c, class) in CLASSES.iter().enumerate() {
+            let rate = onsets[g][c] as f64 / at_risk[g][c].max(1) as f64;
+            println!(
+                "  {class:>16}: {:>6} at-risk finger-frames, {:>4} onsets, {:.2} per 100",
+                at_risk[g][c],
+                onsets[g][c],
+                100.0 * rate
+            );
+        }
+    }
+    Ok(())
+}
