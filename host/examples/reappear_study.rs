@@ -14,7 +14,7 @@
 //!
 //! ```text
 //! digiteyes bench robustness --seeds 60 --frames 200 --keep /tmp/keep
-//! cargo run --release -p digiteyes-host --example reappear_study -- /tmp/keep [--window 10]
+//! cargo run --release -p digiteyes-host --example reappear_study -- /tmp/keep [--window 10] [--oracle]
 //! ```
 
 use std::path::PathBuf;
@@ -48,6 +48,10 @@ struct Args {
     /// The palm's limit (mm): onsets with the palm farther off are the hand's, not a finger's.
     #[arg(long, default_value_t = 30.0)]
     palm_mm: f64,
+    /// Follow the seen-oracle of `seen_bound` (every seen joint true, an unseen one held)
+    /// instead of the tracked states: how often a finger goes wrong only by being held.
+    #[arg(long)]
+    oracle: bool,
 }
 
 /// The three classes of an at-risk frame.
@@ -61,12 +65,16 @@ struct Frame {
     palm_mm: f64,
 }
 
-fn frames(dir: &std::path::Path) -> Result<Vec<Frame>> {
+fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
     let sequence = Sequence::open(dir)?;
     let model = &sequence.model;
     let n = sequence.n_states();
     let truth = kept::f32s(&sequence.read_truth()?.rows);
-    let tracked = kept::f32s(&read_states(&dir.join("states.csv"), n)?.rows);
+    let tracked = if oracle {
+        seen::oracle(&sequence, &truth, 1, seen::Unseen::Hold)?.0
+    } else {
+        kept::f32s(&read_states(&dir.join("states.csv"), n)?.rows)
+    };
     let mut view = ProjectedModel::default();
     let mut out = Vec::new();
     for (t, e) in truth.iter().zip(&tracked) {
@@ -119,7 +127,7 @@ fn main() -> Result<()> {
                 .and_then(|n| n.trim_start_matches("seed").parse().ok())
                 .unwrap_or(0);
             let g = (seed % 2) as usize;
-            let f = frames(&dir)?;
+            let f = frames(&dir, args.oracle)?;
             let fingers = f.first().map_or(0, |f| f.tip_px.len());
             for finger in 0..fingers {
                 for k in 1..f.len().saturating_sub(args.hold) {

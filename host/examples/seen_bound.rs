@@ -23,7 +23,6 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use clap::Parser;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::model::BASE_STATES;
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_host::eval::stats::percentile;
 use digiteyes_host::eval::{reprojection_error, track_life};
@@ -34,6 +33,8 @@ mod kept;
 #[path = "common/seen.rs"]
 mod seen;
 
+use seen::{oracle, Unseen};
+
 #[derive(Parser)]
 struct Args {
     /// Folders of kept seeds (`seedNNNN/`), as `bench robustness --keep` writes.
@@ -42,53 +43,6 @@ struct Args {
     /// Points along a link's axis that must be seen for the link to count as seen.
     #[arg(long, default_value_t = 1)]
     points: usize,
-}
-
-/// A joint's guess while it is not seen.
-#[derive(Clone, Copy)]
-enum Unseen {
-    Hold,
-    Velocity,
-}
-
-/// The seen-oracle's states over `truth`, and the share of joint-frames not seen.
-fn oracle(
-    sequence: &Sequence,
-    truth: &[Vec<f32>],
-    points: usize,
-    how: Unseen,
-) -> Result<(Vec<Vec<f32>>, f64)> {
-    let model = &sequence.model;
-    let n = model.n_states();
-    let mut out: Vec<Vec<f32>> = Vec::with_capacity(truth.len());
-    let mut speed = vec![0.0f32; n];
-    let (mut unseen, mut total) = (0usize, 0usize);
-    for (k, t) in truth.iter().enumerate() {
-        let poses = Poses::compute(model, t)?;
-        let seen = seen::joints(sequence, &poses, points);
-        let mut state = t.clone();
-        if let Some(last) = out.last() {
-            for j in BASE_STATES..n {
-                total += 1;
-                if seen[j] {
-                    speed[j] = t[j] - truth[k - 1][j];
-                    continue;
-                }
-                unseen += 1;
-                let step = match how {
-                    Unseen::Hold => 0.0,
-                    Unseen::Velocity => speed[j],
-                };
-                let mut v = last[j] + step;
-                if let Some(l) = model.limit(j) {
-                    v = v.clamp(l.lo, l.hi);
-                }
-                state[j] = v;
-            }
-        }
-        out.push(state);
-    }
-    Ok((out, unseen as f64 / total.max(1) as f64))
 }
 
 /// Mean fingertip error over every tip and camera, per frame (px).
