@@ -24,6 +24,7 @@ use clap::Parser;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_host::eval::reprojection_error;
+use digiteyes_host::eval::stats::percentile;
 use digiteyes_host::sequence::{read_states, Sequence};
 
 #[path = "common/kept.rs"]
@@ -63,6 +64,9 @@ struct Frame {
     tip_px: Vec<f64>,
     seen: Vec<bool>,
     palm_mm: f64,
+    /// Per finger: the largest error of a joint the truth's links show, and of one they hide
+    /// (rad; `None` when the finger has no such joint).
+    joint_rad: Vec<[Option<f64>; 2]>,
 }
 
 fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
@@ -82,6 +86,7 @@ fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
         let joints_seen = seen::joints(&sequence, &pt, 1);
         let mut tip_px: Vec<f64> = Vec::new();
         let mut seen = Vec::new();
+        let mut joint_rad = Vec::new();
         for (c, camera) in sequence.cameras.iter().enumerate() {
             view.update(model, &pt, camera, 0.0);
             for (f, link) in view.links.iter().filter(|l| l.distal).enumerate() {
@@ -94,6 +99,14 @@ fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
                         .and_then(|chain| chain.last().copied())
                         .map(usize::from);
                     seen.push(last.is_some_and(|s| joints_seen[s]));
+                    let mut worst = [None::<f64>; 2];
+                    for s in model.chain(usize::from(link.frame)).unwrap_or_default() {
+                        let s = usize::from(s);
+                        let error = f64::from((t[s] - e[s]).abs());
+                        let w = &mut worst[usize::from(!joints_seen[s])];
+                        *w = Some(w.map_or(error, |v: f64| v.max(error)));
+                    }
+                    joint_rad.push(worst);
                 }
                 if let Some(v) = tip_px.get_mut(f) {
                     *v += error / sequence.cameras.len() as f64;
@@ -108,6 +121,7 @@ fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
             tip_px,
             seen,
             palm_mm,
+            joint_rad,
         });
     }
     Ok(out)
@@ -119,6 +133,8 @@ fn main() -> Result<()> {
     // Per group (stereo 0, mono 1), per class: at-risk frames and onsets.
     let mut at_risk = [[0usize; 3]; 2];
     let mut onsets = [[0usize; 3]; 2];
+    // Per group, per class: at each onset, the finger's worst seen and hidden joint errors.
+    let mut at_onset: [[[Vec<f64>; 2]; 3]; 2] = Default::default();
     for base in &args.dirs {
         for dir in kept::seed_dirs(base)? {
             let seed: u64 = dir
@@ -146,6 +162,9 @@ fn main() -> Result<()> {
                         && f[k].palm_mm <= args.palm_mm;
                     if onset {
                         onsets[g][class] += 1;
+                        for (v, e) in at_onset[g][class].iter_mut().zip(f[k].joint_rad[finger]) {
+                            v.extend(e);
+                        }
                     }
                 }
             }
@@ -156,11 +175,24 @@ fn main() -> Result<()> {
         println!("{name}: {total} finger onsets");
         for (c, class) in CLASSES.iter().enumerate() {
             let rate = onsets[g][c] as f64 / at_risk[g][c].max(1) as f64;
+            let median = |v: &[f64]| {
+                if v.is_empty() {
+                    "-".to_string()
+                } else {
+                    format!("{:.0}°", percentile(v, 0.5).to_degrees())
+                }
+            };
+            let [shown, hidden] = &at_onset[g][c];
             println!(
-                "  {class:>16}: {:>6} at-risk finger-frames, {:>4} onsets, {:.2} per 100",
+                "  {class:>16}: {:>6} at-risk finger-frames, {:>4} onsets, {:.2} per 100; \
+                 at onset, worst joint error median: shown {} ({} fingers), hidden {} ({})",
                 at_risk[g][c],
                 onsets[g][c],
-                100.0 * rate
+                100.0 * rate,
+                median(shown),
+                shown.len(),
+                median(hidden),
+                hidden.len()
             );
         }
     }
