@@ -156,19 +156,28 @@ fn main() -> Result<()> {
 /// The seed-by-seed comparison of `lives` with `base`, per group.
 fn paired(name: &str, base: &[(u64, f64)], lives: &[(u64, f64)]) {
     for (group, parity) in [("mono", 1), ("stereo", 0), ("all", 2)] {
-        let deltas: Vec<f64> = lives
+        // (life before, life after) of each seed of the group.
+        let pairs: Vec<(f64, f64)> = lives
             .iter()
             .filter(|(s, _)| parity == 2 || s % 2 == parity)
-            .filter_map(|(s, l)| base.iter().find(|(b, _)| b == s).map(|(_, b)| l - b))
+            .filter_map(|(s, l)| base.iter().find(|(b, _)| b == s).map(|(_, b)| (*b, *l)))
             .collect();
-        if deltas.is_empty() {
+        if pairs.is_empty() {
             continue;
         }
-        let better = deltas.iter().filter(|&&d| d > 0.05).count();
-        let worse = deltas.iter().filter(|&&d| d < -0.05).count();
+        let better = pairs.iter().filter(|(b, l)| l - b > 0.05).count();
+        let worse = pairs.iter().filter(|(b, l)| l - b < -0.05).count();
+        let rose = pairs
+            .iter()
+            .filter(|(b, l)| *b < 0.95 && *l >= 0.95)
+            .count();
+        let fell = pairs
+            .iter()
+            .filter(|(b, l)| *b >= 0.95 && *l < 0.95)
+            .count();
         println!(
-            "  paired {name} {group}: mean life change {:+.1} points, {better} seeds gained > 5, {worse} lost > 5, sign test p {:.3}",
-            100.0 * deltas.iter().sum::<f64>() / deltas.len() as f64,
+            "  paired {name} {group}: mean life change {:+.1} points, {better} seeds gained > 5, {worse} lost > 5, sign test p {:.3}; {rose} rose to >= 95 %, {fell} fell below",
+            100.0 * pairs.iter().map(|(b, l)| l - b).sum::<f64>() / pairs.len() as f64,
             sign_test(better, worse)
         );
     }
