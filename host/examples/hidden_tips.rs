@@ -83,11 +83,7 @@ fn main() -> Result<()> {
     let mut lost = [(0usize, 0usize); 2];
     let mut hidden = [Vec::new(), Vec::new()];
     for dir in kept::seed_dirs(&args.dir)? {
-        let seed: u64 = dir
-            .file_name()
-            .and_then(|n| n.to_str())
-            .and_then(|n| n.trim_start_matches("seed").parse().ok())
-            .unwrap_or(0);
+        let seed = kept::seed_of(&dir);
         let g = (seed % 2) as usize;
         let f = frames(&dir, &args.states)?;
         let all: Vec<f64> = f.iter().map(|f| f.all_px).collect();

@@ -93,14 +93,12 @@ fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
                 let error = reprojection_error(camera, &pt, &pe, usize::from(link.child));
                 if c == 0 {
                     tip_px.push(0.0);
+                    let chain = model.chain(usize::from(link.frame)).unwrap_or_default();
                     // The distal link's own joint: the last state of its chain.
-                    let last = model
-                        .chain(usize::from(link.frame))
-                        .and_then(|chain| chain.last().copied())
-                        .map(usize::from);
+                    let last = chain.last().copied().map(usize::from);
                     seen.push(last.is_some_and(|s| joints_seen[s]));
                     let mut worst = [None::<f64>; 2];
-                    for s in model.chain(usize::from(link.frame)).unwrap_or_default() {
+                    for &s in &chain {
                         let s = usize::from(s);
                         let error = f64::from((t[s] - e[s]).abs());
                         let w = &mut worst[usize::from(!joints_seen[s])];
@@ -137,11 +135,7 @@ fn main() -> Result<()> {
     let mut at_onset: [[[Vec<f64>; 2]; 3]; 2] = Default::default();
     for base in &args.dirs {
         for dir in kept::seed_dirs(base)? {
-            let seed: u64 = dir
-                .file_name()
-                .and_then(|n| n.to_str())
-                .and_then(|n| n.trim_start_matches("seed").parse().ok())
-                .unwrap_or(0);
+            let seed = kept::seed_of(&dir);
             let g = (seed % 2) as usize;
             let f = frames(&dir, args.oracle)?;
             let fingers = f.first().map_or(0, |f| f.tip_px.len());

@@ -18,7 +18,7 @@
 //! cargo run --release -p digiteyes-host --example seen_bound -- /tmp/keep [--points 1]
 //! ```
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Parser;
@@ -69,13 +69,6 @@ fn tip_errors(sequence: &Sequence, truth: &[Vec<f32>], states: &[Vec<f32>]) -> R
     Ok(out)
 }
 
-fn seed_of(dir: &Path) -> u64 {
-    dir.file_name()
-        .and_then(|n| n.to_str())
-        .and_then(|n| n.trim_start_matches("seed").parse().ok())
-        .unwrap_or(0)
-}
-
 fn main() -> Result<()> {
     let args = Args::parse();
     let ways = [("hold", Unseen::Hold), ("velocity", Unseen::Velocity)];
@@ -84,7 +77,7 @@ fn main() -> Result<()> {
     let mut unseen = [Vec::new(), Vec::new()];
     for base in &args.dirs {
         for dir in kept::seed_dirs(base)? {
-            let seed = seed_of(&dir);
+            let seed = kept::seed_of(&dir);
             let g = (seed % 2) as usize;
             let sequence = Sequence::open(&dir)?;
             let truth = kept::f32s(&sequence.read_truth()?.rows);

@@ -21,6 +21,14 @@ pub fn seed_dirs(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(dirs)
 }
 
+/// The seed of a kept seed's folder (`seedNNNN`; 0 when the name is not one).
+pub fn seed_of(dir: &Path) -> u64 {
+    dir.file_name()
+        .and_then(|n| n.to_str())
+        .and_then(|n| n.trim_start_matches("seed").parse().ok())
+        .unwrap_or(0)
+}
+
 /// State rows as the tracker takes them (f32).
 pub fn f32s(rows: &[Vec<f64>]) -> Vec<Vec<f32>> {
     rows.iter()
