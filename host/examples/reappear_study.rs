@@ -53,6 +53,10 @@ struct Args {
     /// instead of the tracked states: how often a finger goes wrong only by being held.
     #[arg(long)]
     oracle: bool,
+    /// Print every onset: seed, finger, frame, class, and the finger's worst shown and hidden
+    /// joint errors (degrees).
+    #[arg(long)]
+    list: bool,
 }
 
 /// The three classes of an at-risk frame.
@@ -156,6 +160,15 @@ fn main() -> Result<()> {
                         && f[k].palm_mm <= args.palm_mm;
                     if onset {
                         onsets[g][class] += 1;
+                        if args.list {
+                            let [shown, hidden] = f[k].joint_rad[finger].map(|e| {
+                                e.map_or("-".into(), |r| format!("{:.0}", r.to_degrees()))
+                            });
+                            println!(
+                                "onset seed {seed} finger {finger} frame {k} {}: shown {shown}°, hidden {hidden}°",
+                                CLASSES[class]
+                            );
+                        }
                         for (v, e) in at_onset[g][class].iter_mut().zip(f[k].joint_rad[finger]) {
                             v.extend(e);
                         }
