@@ -71,6 +71,9 @@ struct Frame {
     /// Per finger: the largest error of a joint the truth's links show, and of one they hide
     /// (rad; `None` when the finger has no such joint).
     joint_rad: Vec<[Option<f64>; 2]>,
+    /// Per finger: which of its joints (the place in its chain from the palm) is the most
+    /// wrong.
+    worst_joint: Vec<usize>,
 }
 
 fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
@@ -91,6 +94,7 @@ fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
         let mut tip_px: Vec<f64> = Vec::new();
         let mut seen = Vec::new();
         let mut joint_rad = Vec::new();
+        let mut worst_joint = Vec::new();
         for (c, camera) in sequence.cameras.iter().enumerate() {
             view.update(model, &pt, camera, 0.0);
             for (f, link) in view.links.iter().filter(|l| l.distal).enumerate() {
@@ -102,13 +106,18 @@ fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
                     let last = chain.last().copied().map(usize::from);
                     seen.push(last.is_some_and(|s| joints_seen[s]));
                     let mut worst = [None::<f64>; 2];
-                    for &s in &chain {
+                    let mut most = (0, -1.0);
+                    for (place, &s) in chain.iter().enumerate() {
                         let s = usize::from(s);
                         let error = f64::from((t[s] - e[s]).abs());
+                        if error > most.1 {
+                            most = (place, error);
+                        }
                         let w = &mut worst[usize::from(!joints_seen[s])];
                         *w = Some(w.map_or(error, |v: f64| v.max(error)));
                     }
                     joint_rad.push(worst);
+                    worst_joint.push(most.0);
                 }
                 if let Some(v) = tip_px.get_mut(f) {
                     *v += error / sequence.cameras.len() as f64;
@@ -124,6 +133,7 @@ fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
             seen,
             palm_mm,
             joint_rad,
+            worst_joint,
         });
     }
     Ok(out)
@@ -137,6 +147,10 @@ fn main() -> Result<()> {
     let mut onsets = [[0usize; 3]; 2];
     // Per group, per class: at each onset, the finger's worst seen and hidden joint errors.
     let mut at_onset: [[[Vec<f64>; 2]; 3]; 2] = Default::default();
+    // Per group: at each onset, how often each place in the finger's chain was the worst
+    // (the four fingers; the thumb apart, as its joints differ).
+    let mut worst_place = [[0usize; 5]; 2];
+    let mut thumb_place = [[0usize; 5]; 2];
     for base in &args.dirs {
         for dir in kept::seed_dirs(base)? {
             let seed = kept::seed_of(&dir);
@@ -160,6 +174,12 @@ fn main() -> Result<()> {
                         && f[k].palm_mm <= args.palm_mm;
                     if onset {
                         onsets[g][class] += 1;
+                        let place = f[k].worst_joint[finger].min(4);
+                        if finger + 1 == fingers {
+                            thumb_place[g][place] += 1;
+                        } else {
+                            worst_place[g][place] += 1;
+                        }
                         if args.list {
                             let [shown, hidden] = f[k].joint_rad[finger].map(|e| {
                                 e.map_or("-".into(), |r| format!("{:.0}", r.to_degrees()))
@@ -179,7 +199,11 @@ fn main() -> Result<()> {
     }
     for (g, name) in [(1, "mono"), (0, "stereo")] {
         let total: usize = onsets[g].iter().sum();
-        println!("{name}: {total} finger onsets");
+        println!(
+            "{name}: {total} finger onsets; the most wrong joint, from the palm out: fingers {:?}, thumb {:?}",
+            &worst_place[g][..4],
+            thumb_place[g]
+        );
         for (c, class) in CLASSES.iter().enumerate() {
             let rate = onsets[g][c] as f64 / at_risk[g][c].max(1) as f64;
             let median = |v: &[f64]| {
