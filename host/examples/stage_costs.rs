@@ -64,6 +64,9 @@ struct Args {
     /// tracker's), to cost the choice.
     #[arg(long)]
     outermost_share: Option<f32>,
+    /// The prior toward mid-range (per rad²; 0: off; default: the tracker's), to cost it.
+    #[arg(long)]
+    range_centre: Option<f32>,
     /// The thesis' plain loop: no motion model, no silhouette check (the cost before them).
     #[arg(long)]
     plain: bool,
@@ -105,6 +108,9 @@ fn main() -> Result<()> {
     }
     if let Some(share) = args.outermost_share {
         config.features.outermost_share = share;
+    }
+    if let Some(weight) = args.range_centre {
+        config.motion.range_centre = weight;
     }
     if let Some(window) = args.window {
         config.features.window_px = window;
