@@ -72,11 +72,12 @@ pub struct MotionConfig {
     /// A lost frame keeps the last good state (and zeroes the velocity) instead of taking
     /// the estimate it ended with.
     pub hold_when_lost: bool,
-    /// A prior toward the middle of each joint's range (per rad²; 0: none), beside the one
-    /// toward the prediction: a direction the images do not see relaxes toward mid-range
-    /// (at the default joint prior, about 2 % of the way a frame) instead of staying wherever
-    /// the last error left it. Default 50: stereo track life +6.6 points on 150 fresh seeds
-    /// (`docs/robustness.md`, "A prior toward mid-range").
+    /// A prior toward the middle of each joint's range (per rad²; 0: none, the default),
+    /// beside the one toward the prediction: a direction the images do not see relaxes toward
+    /// mid-range (at 50 and the default joint prior, about 2 % of the way a frame) instead of
+    /// staying wherever the last error left it. At 50, stereo track life +6.6 points on 150
+    /// fresh sweep seeds; off by default because a finger seen end-on then no longer keeps
+    /// its joints (`docs/robustness.md`, "A prior toward mid-range").
     pub range_centre: f32,
 }
 
@@ -94,9 +95,9 @@ impl MotionConfig {
 impl MotionConfig {
     /// The default: a prior toward the prediction on the joints (2000 per rad²) and the
     /// palm's position (1 per mm²), the velocity trusted in full from 70 % of the expected
-    /// features found, a lost frame held, and a weak prior toward mid-range (50 per rad²).
-    /// Chosen on the randomised sweep of `docs/robustness.md` (seeds never tuned on), where
-    /// it beat [`MotionConfig::PLAIN`] on every figure.
+    /// features found, a lost frame held; no prior toward mid-range. Chosen on the randomised
+    /// sweep of `docs/robustness.md` (seeds never tuned on), where it beat
+    /// [`MotionConfig::PLAIN`] on every figure.
     pub const DEFAULT: MotionConfig = MotionConfig {
         prior: PriorWeights {
             quaternion: 0.0,
@@ -105,7 +106,7 @@ impl MotionConfig {
         },
         full_velocity_found: 0.7,
         hold_when_lost: true,
-        range_centre: 50.0,
+        range_centre: 0.0,
     };
 }
 

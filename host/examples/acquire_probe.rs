@@ -145,6 +145,9 @@ struct Args {
     /// The tracker's outermost-edge share (0: the strongest edge; default: the tracker's).
     #[arg(long)]
     outermost_share: Option<f32>,
+    /// The tracker's prior toward mid-range (per rad²; default: the tracker's, 0).
+    #[arg(long)]
+    range_centre: Option<f32>,
     /// The tracker's Gauss–Newton iterations per frame (default: the tracker's).
     #[arg(long)]
     tracker_iterations: Option<u8>,
@@ -262,10 +265,15 @@ static TRACKER_ANGLE_DEG: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
 /// The tracker's outermost-edge share, when `--outermost-share` gives one (set once in `main`).
 static TRACKER_OUTERMOST: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
 
+/// The tracker's prior toward mid-range, when `--range-centre` gives one (set once in
+/// `main`).
+static TRACKER_RANGE_CENTRE: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
+
 /// The tracker's iterations, when `--tracker-iterations` gives them (set once in `main`).
 static TRACKER_ITERATIONS: std::sync::OnceLock<u8> = std::sync::OnceLock::new();
 
-/// The tracker's defaults, with `--angle-deg` and `--outermost-share` if given.
+/// The tracker's defaults, with `--angle-deg`, `--outermost-share`, `--tracker-iterations`
+/// and `--range-centre` if given.
 fn tracker_config() -> TrackerConfig {
     let mut config = TrackerConfig::default();
     if let Some(degrees) = TRACKER_ANGLE_DEG.get() {
@@ -276,6 +284,9 @@ fn tracker_config() -> TrackerConfig {
     }
     if let Some(iterations) = TRACKER_ITERATIONS.get() {
         config.iterations = *iterations;
+    }
+    if let Some(weight) = TRACKER_RANGE_CENTRE.get() {
+        config.motion.range_centre = *weight;
     }
     config
 }
@@ -954,6 +965,9 @@ fn main() -> Result<()> {
     }
     if let Some(iterations) = args.tracker_iterations {
         let _ = TRACKER_ITERATIONS.set(iterations);
+    }
+    if let Some(weight) = args.range_centre {
+        let _ = TRACKER_RANGE_CENTRE.set(weight);
     }
     if let Some(dark) = args.blackout.clone() {
         return blackout_sweep(&args, &dark);
