@@ -180,6 +180,28 @@ fn end_on_camera(model: &Model, q: &[f32]) -> Camera {
     }
 }
 
+/// The renderer of `end_on_camera`'s frames (2× supersampled, noise σ 3).
+fn end_on_renderer(model: &Model, camera: &Camera) -> Renderer {
+    let settings = RenderSettings {
+        supersample: 2,
+        noise_sigma: 3.0,
+        ..RenderSettings::default()
+    };
+    Renderer::new(model, camera, settings)
+}
+
+/// A tracker of every state of the hand seen by `camera` alone, starting at `q`.
+fn one_camera_tracker(model: &Model, camera: Camera, q: &[f32], config: TrackerConfig) -> Tracker {
+    Tracker::new(
+        model.clone(),
+        &[camera],
+        q,
+        FreeMask::all(model.n_states()),
+        config,
+    )
+    .unwrap()
+}
+
 #[test]
 fn a_finger_seen_end_on_keeps_its_joints() {
     let model = Model::hand().unwrap();
@@ -188,21 +210,9 @@ fn a_finger_seen_end_on_keeps_its_joints() {
     q[6] = 0.0;
     (q[12], q[13], q[14]) = (0.15, 0.25, 0.15);
     let camera = end_on_camera(&model, &q);
-    let settings = RenderSettings {
-        supersample: 2,
-        noise_sigma: 3.0,
-        ..RenderSettings::default()
-    };
-    let renderer = Renderer::new(&model, &camera, settings);
+    let renderer = end_on_renderer(&model, &camera);
     let run = |config: TrackerConfig| -> f32 {
-        let mut t = Tracker::new(
-            model.clone(),
-            &[camera],
-            &q,
-            FreeMask::all(model.n_states()),
-            config,
-        )
-        .unwrap();
+        let mut t = one_camera_tracker(&model, camera, &q, config);
         let mut worst = 0.0f32;
         for k in 0..30 {
             // The other fingers flex and the palm sways; finger 2 holds still.
@@ -260,26 +270,14 @@ fn a_split_the_images_do_not_see_relaxes_toward_mid_range() {
         }
     }
     let camera = end_on_camera(&model, &truth);
-    let settings = RenderSettings {
-        supersample: 2,
-        noise_sigma: 3.0,
-        ..RenderSettings::default()
-    };
-    let renderer = Renderer::new(&model, &camera, settings);
+    let renderer = end_on_renderer(&model, &camera);
     let mut start = truth.clone();
     start[12] -= 0.4;
     start[13] += 0.4;
     let run = |range_centre: f32| -> f32 {
         let mut config = robust_config();
         config.motion.range_centre = range_centre;
-        let mut t = Tracker::new(
-            model.clone(),
-            &[camera],
-            &start,
-            FreeMask::all(model.n_states()),
-            config,
-        )
-        .unwrap();
+        let mut t = one_camera_tracker(&model, camera, &start, config);
         for k in 0..60 {
             let image = renderer.render(&truth, k).unwrap();
             t.track(&[view(&image)]).unwrap();
