@@ -76,8 +76,10 @@ pub struct MotionConfig {
     /// beside the one toward the prediction: a direction the images do not see relaxes toward
     /// mid-range (at 50 and the default joint prior, about 2 % of the way a frame) instead of
     /// staying wherever the last error left it. At 50, stereo track life +6.6 points on 150
-    /// fresh sweep seeds; off by default because a finger seen end-on then no longer keeps
-    /// its joints (`docs/robustness.md`, "A prior toward mid-range").
+    /// fresh sweep seeds, whose joints swing about mid-range; off by default because a finger
+    /// seen end-on then no longer keeps its joints, and on the same rigs with motions centred
+    /// off mid-range it costs 22–31 points of mono life (`docs/robustness.md`, "A prior toward
+    /// mid-range", "Off-centre motions").
     pub range_centre: f32,
 }
 
