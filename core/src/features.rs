@@ -61,6 +61,10 @@ pub struct FeatureConfig {
     pub mask_occluded: bool,
     /// Search for fingertips.
     pub tips: bool,
+    /// Also search beyond a knuckle where the outline ends there
+    /// ([`ProjectedLink::knuckle_ends`]: the next link seen end-on or turned back), as for a
+    /// fingertip (needs `tips`).
+    pub knuckle_tips: bool,
     /// Also slice across the palm box's own image outline ([`find_palm_edge_features`]),
     /// so the palm's pose is seen by its edges and not only through the fingers'.
     pub palm_edges: bool,
@@ -95,6 +99,7 @@ impl Default for FeatureConfig {
             polarity: Polarity::DarkOutside,
             mask_occluded: true,
             tips: true,
+            knuckle_tips: true,
             palm_edges: true,
             max_edge_angle_rad: core::f32::consts::FRAC_PI_6,
             outermost_share: 0.5,
@@ -103,6 +108,12 @@ impl Default for FeatureConfig {
 }
 
 impl FeatureConfig {
+    /// Whether a tip search runs beyond `link`'s end `b`: a fingertip's, or (with
+    /// `knuckle_tips`) a knuckle where the outline ends.
+    pub fn searches_tip(&self, link: &crate::projection::ProjectedLink) -> bool {
+        self.tips && (link.distal || (self.knuckle_tips && link.knuckle_ends))
+    }
+
     /// `tan(max_edge_angle_rad)`, or `None` when every edge is kept.
     pub fn edge_tangent_limit(&self) -> Option<f32> {
         (self.max_edge_angle_rad < core::f32::consts::FRAC_PI_2 - 1e-3)
@@ -470,7 +481,7 @@ fn search_link<W: FnMut(&SearchWindow)>(
     // distance, so only the links and palm whose bounds meet that box are tested.
     let (among, palm) = if config.mask_occluded {
         let reach = Vector2::new(PROBE_BEYOND_EDGE_PX, PROBE_BEYOND_EDGE_PX);
-        let tip = if config.tips && link.distal {
+        let tip = if config.searches_tip(link) {
             link.b + dir * (link.tip_offset + PROBE_BEYOND_EDGE_PX)
         } else {
             link.b
@@ -574,7 +585,7 @@ fn search_link<W: FnMut(&SearchWindow)>(
             }
         }
     }
-    if config.tips && link.distal {
+    if config.searches_tip(link) {
         let predicted = link.b + dir * link.tip_offset;
         if let Some((position, _)) = search(predicted, dir, link.z1, RefusedWindows::TIP, out) {
             out.tip = Some(position);

@@ -84,6 +84,7 @@ impl PalmOutline {
                 frame: palm.frame,
                 child: palm.frame,
                 distal: false,
+                knuckle_ends: false,
                 radius_mm: 0.0,
                 p0: palm.corners_mm[i0],
                 p1: palm.corners_mm[i1],

@@ -55,6 +55,15 @@ pub struct ProjectedLink {
     pub child: u8,
     /// Whether the child is a fingertip (a tip search runs beyond `b`).
     pub distal: bool,
+    /// Whether the link's next link, seen from this camera, is taken to leave the hand's
+    /// outline ending at `b`: it turns back over this link (more than 90° from its image
+    /// axis), or is shorter in the image than this link's end radius and points away from
+    /// the camera. A finger curled away from the camera then shows its knuckle where a
+    /// straight one shows its tip. (Where a short next link still reaches beyond the
+    /// knuckle's outline, the outline ends a little farther than `b`; the stricter test,
+    /// that it does not, was measured and gave less: `docs/robustness.md`.) False for a
+    /// fingertip's link (see `distal`) and for a link with no next one.
+    pub knuckle_ends: bool,
     /// Capsule radius (mm).
     pub radius_mm: f32,
     /// Axis start and end in the world (mm).
@@ -268,10 +277,21 @@ impl ProjectedModel {
                         .links()
                         .get(usize::from(child))
                         .is_some_and(|c| matches!(c.shape, Shape::Tip { .. }));
+                    let knuckle_ends = !distal
+                        && knuckle_ends(
+                            model,
+                            poses,
+                            camera,
+                            child,
+                            (&a, &b),
+                            z1,
+                            r1[0].max(r1[1]),
+                        );
                     let _ = self.links.push(ProjectedLink {
                         frame: i as u8,
                         child,
                         distal,
+                        knuckle_ends,
                         radius_mm: radius,
                         p0,
                         p1,
@@ -366,6 +386,39 @@ fn project_box(
         lo,
         hi,
     })
+}
+
+/// Whether the link after frame `child` leaves the outline of the link `a`→`b` ending at `b`
+/// ([`ProjectedLink::knuckle_ends`]): its image axis turns back (a negative dot product with
+/// `b − a`), or is shorter than `end_radius_px` while its far end lies deeper than `depth_b`
+/// (mm). False when it cannot be projected.
+fn knuckle_ends(
+    model: &Model,
+    poses: &Poses,
+    camera: &Camera,
+    child: u8,
+    (a, b): (&Vector2<f32>, &Vector2<f32>),
+    depth_b: f32,
+    end_radius_px: f32,
+) -> bool {
+    let Some(next) = model
+        .links()
+        .get(usize::from(child))
+        .filter(|l| matches!(l.shape, Shape::Cylinder { .. }))
+        .and_then(|l| l.children.first())
+    else {
+        return false;
+    };
+    let Some(far) = poses.origin(usize::from(*next)) else {
+        return false;
+    };
+    let Some(end) = camera.project(&far) else {
+        return false;
+    };
+    let onward = end - b;
+    let turns_back = onward.dot(&(b - a)) < 0.0;
+    let short_and_away = onward.norm() < end_radius_px && camera.to_camera(&far).z > depth_b;
+    turns_back || short_and_away
 }
 
 /// Offsets (px) from the image axis to the two silhouette lines of the cylinder of radius

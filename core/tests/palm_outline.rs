@@ -335,6 +335,7 @@ fn fake_link(frame: u8, a: Vector2<f32>, b: Vector2<f32>, r: f32, z: f32) -> Pro
         frame,
         child: frame + 1,
         distal: false,
+        knuckle_ends: false,
         radius_mm: 10.0,
         p0: Vector3::zeros(),
         p1: Vector3::zeros(),

@@ -65,7 +65,7 @@ fn watched_search_finds_the_same_features_and_reports_every_window() {
 
         let count = |o: WindowOutcome| windows.iter().filter(|w| w.outcome == o).count();
         let link = &view.links[index];
-        let tips = usize::from(config.tips && link.distal);
+        let tips = usize::from(config.searches_tip(link));
         assert_eq!(
             windows.len(),
             2 * usize::from(config.slices_per_link) + tips

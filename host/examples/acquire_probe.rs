@@ -148,6 +148,10 @@ struct Args {
     /// The tracker's prior toward mid-range (per rad²; default: the tracker's, 0).
     #[arg(long)]
     range_centre: Option<f32>,
+    /// Whether the tracker searches beyond knuckles where the outline ends (default: the
+    /// tracker's).
+    #[arg(long)]
+    knuckle_tips: Option<bool>,
     /// The tracker's Gauss–Newton iterations per frame (default: the tracker's).
     #[arg(long)]
     tracker_iterations: Option<u8>,
@@ -268,6 +272,9 @@ static TRACKER_OUTERMOST: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
 /// The tracker's prior toward mid-range, when `--range-centre` gives one (set once in
 /// `main`).
 static TRACKER_RANGE_CENTRE: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
+/// Whether the tracker searches beyond knuckles, when `--knuckle-tips` says (set once in
+/// `main`).
+static TRACKER_KNUCKLE_TIPS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
 
 /// The tracker's iterations, when `--tracker-iterations` gives them (set once in `main`).
 static TRACKER_ITERATIONS: std::sync::OnceLock<u8> = std::sync::OnceLock::new();
@@ -287,6 +294,9 @@ fn tracker_config() -> TrackerConfig {
     }
     if let Some(weight) = TRACKER_RANGE_CENTRE.get() {
         config.motion.range_centre = *weight;
+    }
+    if let Some(on) = TRACKER_KNUCKLE_TIPS.get() {
+        config.features.knuckle_tips = *on;
     }
     config
 }
@@ -965,6 +975,9 @@ fn main() -> Result<()> {
     }
     if let Some(iterations) = args.tracker_iterations {
         let _ = TRACKER_ITERATIONS.set(iterations);
+    }
+    if let Some(on) = args.knuckle_tips {
+        let _ = TRACKER_KNUCKLE_TIPS.set(on);
     }
     if let Some(weight) = args.range_centre {
         let _ = TRACKER_RANGE_CENTRE.set(weight);

@@ -59,6 +59,9 @@ fn the_palm_outline_keeps_seed_39s_palm_where_the_fingers_lie_across_it() {
     // The edge-direction test (on by default since) also keeps this palm from turning as
     // far (26 deg without the palm edges); off here, to judge the palm edges alone.
     with.features.max_edge_angle_rad = core::f32::consts::FRAC_PI_2;
+    // So do the knuckle tips (on by default since: 2.7 deg at most without the palm edges);
+    // off here too.
+    with.features.knuckle_tips = false;
     let mut without = with;
     without.features.palm_edges = false;
     let (on, off) = (

@@ -79,6 +79,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "palm" => c.features.palm_edges = f != 0.0,
             "angle" => c.features.max_edge_angle_rad = f.to_radians(),
             "outer" => c.features.outermost_share = f,
+            "knuckle" => c.features.knuckle_tips = f != 0.0,
             "fvf" => c.motion.full_velocity_found = f,
             "palmw" => c.estimator.palm_edge_weight = f,
             "sj" => c.estimator.conditioning.joint = f,
