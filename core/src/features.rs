@@ -15,6 +15,7 @@ use crate::camera::Camera;
 use crate::config::{MAX_SLICES_PER_LINK, MAX_WINDOW};
 use crate::frame::FrameView;
 use crate::projection::Bounds;
+use crate::projection::ProjectedLink;
 use crate::projection::ProjectedModel;
 use crate::visibility::{candidates, cover_among, Cover};
 
@@ -61,9 +62,12 @@ pub struct FeatureConfig {
     pub mask_occluded: bool,
     /// Search for fingertips.
     pub tips: bool,
-    /// Also search beyond a knuckle where the outline ends there
-    /// ([`ProjectedLink::knuckle_ends`]: the next link seen end-on or turned back), as for a
-    /// fingertip (needs `tips`).
+    /// Also search beyond a knuckle where the outline ends there, as beyond a fingertip
+    /// (needs `tips`): where the next link, from this camera, turns back over the link or is
+    /// seen end-on pointing away ([`ProjectedLink::knuckle_ends`]), as a finger curled away
+    /// from the camera is. On by default: track life +10.1 points mono and +4.9 stereo on 300
+    /// fresh seeds (+22.4 mono from overhead), cost within ±4 % a frame
+    /// (`docs/robustness.md`, "Knuckle tips").
     pub knuckle_tips: bool,
     /// Also slice across the palm box's own image outline ([`find_palm_edge_features`]),
     /// so the palm's pose is seen by its edges and not only through the fingers'.
@@ -110,7 +114,7 @@ impl Default for FeatureConfig {
 impl FeatureConfig {
     /// Whether a tip search runs beyond `link`'s end `b`: a fingertip's, or (with
     /// `knuckle_tips`) a knuckle where the outline ends.
-    pub fn searches_tip(&self, link: &crate::projection::ProjectedLink) -> bool {
+    pub fn searches_tip(&self, link: &ProjectedLink) -> bool {
         self.tips && (link.distal || (self.knuckle_tips && link.knuckle_ends))
     }
 

@@ -67,6 +67,10 @@ struct Args {
     /// The prior toward mid-range (per rad²; 0: off; default: the tracker's), to cost it.
     #[arg(long)]
     range_centre: Option<f32>,
+    /// Whether the tip search also runs beyond knuckles where the outline ends (default: the
+    /// tracker's), to cost it.
+    #[arg(long)]
+    knuckle_tips: Option<bool>,
     /// The thesis' plain loop: no motion model, no silhouette check (the cost before them).
     #[arg(long)]
     plain: bool,
@@ -111,6 +115,9 @@ fn main() -> Result<()> {
     }
     if let Some(weight) = args.range_centre {
         config.motion.range_centre = weight;
+    }
+    if let Some(on) = args.knuckle_tips {
+        config.features.knuckle_tips = on;
     }
     if let Some(window) = args.window {
         config.features.window_px = window;
