@@ -72,15 +72,6 @@ pub struct MotionConfig {
     /// A lost frame keeps the last good state (and zeroes the velocity) instead of taking
     /// the estimate it ended with.
     pub hold_when_lost: bool,
-    /// A prior toward the middle of each joint's range (per rad²; 0: none, the default),
-    /// beside the one toward the prediction: a direction the images do not see relaxes toward
-    /// mid-range (at 50 and the default joint prior, about 2 % of the way a frame) instead of
-    /// staying wherever the last error left it. At 50, stereo track life +6.6 points on 150
-    /// fresh sweep seeds, whose joints swing about mid-range; off by default because a finger
-    /// seen end-on then no longer keeps its joints, and on the same rigs with motions centred
-    /// off mid-range it costs 22–31 points of mono life (`docs/robustness.md`, "A prior toward
-    /// mid-range", "Off-centre motions").
-    pub range_centre: f32,
 }
 
 impl MotionConfig {
@@ -90,14 +81,13 @@ impl MotionConfig {
         prior: PriorWeights::OFF,
         full_velocity_found: 0.0,
         hold_when_lost: false,
-        range_centre: 0.0,
     };
 }
 
 impl MotionConfig {
     /// The default: a prior toward the prediction on the joints (2000 per rad²) and the
     /// palm's position (1 per mm²), the velocity trusted in full from 70 % of the expected
-    /// features found, a lost frame held; no prior toward mid-range. Chosen on the randomised
+    /// features found, a lost frame held. Chosen on the randomised
     /// sweep of `docs/robustness.md` (seeds never tuned on), where it beat
     /// [`MotionConfig::PLAIN`] on every figure.
     pub const DEFAULT: MotionConfig = MotionConfig {
@@ -108,7 +98,6 @@ impl MotionConfig {
         },
         full_velocity_found: 0.7,
         hold_when_lost: true,
-        range_centre: 0.0,
     };
 }
 

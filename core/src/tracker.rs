@@ -615,15 +615,6 @@ impl Tracker {
             work.normal
                 .add_prior(i, prior.for_state(i), *now - *centre, self.free);
         }
-        if config.motion.range_centre > 0.0 {
-            for (i, now) in q.iter().enumerate() {
-                if let Some(limit) = self.model.limit(i) {
-                    let middle = 0.5 * (limit.lo + limit.hi);
-                    work.normal
-                        .add_prior(i, config.motion.range_centre, *now - middle, self.free);
-                }
-            }
-        }
         work.normal.step(
             self.model.n_states(),
             self.free,

@@ -145,9 +145,6 @@ struct Args {
     /// The tracker's outermost-edge share (0: the strongest edge; default: the tracker's).
     #[arg(long)]
     outermost_share: Option<f32>,
-    /// The tracker's prior toward mid-range (per rad²; default: the tracker's, 0).
-    #[arg(long)]
-    range_centre: Option<f32>,
     /// Whether the tracker searches beyond knuckles where the outline ends (default: the
     /// tracker's).
     #[arg(long)]
@@ -269,9 +266,6 @@ static TRACKER_ANGLE_DEG: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
 /// The tracker's outermost-edge share, when `--outermost-share` gives one (set once in `main`).
 static TRACKER_OUTERMOST: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
 
-/// The tracker's prior toward mid-range, when `--range-centre` gives one (set once in
-/// `main`).
-static TRACKER_RANGE_CENTRE: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
 /// Whether the tracker searches beyond knuckles, when `--knuckle-tips` says (set once in
 /// `main`).
 static TRACKER_KNUCKLE_TIPS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
@@ -280,7 +274,7 @@ static TRACKER_KNUCKLE_TIPS: std::sync::OnceLock<bool> = std::sync::OnceLock::ne
 static TRACKER_ITERATIONS: std::sync::OnceLock<u8> = std::sync::OnceLock::new();
 
 /// The tracker's defaults, with `--angle-deg`, `--outermost-share`, `--tracker-iterations`
-/// and `--range-centre` if given.
+/// and `--knuckle-tips` if given.
 fn tracker_config() -> TrackerConfig {
     let mut config = TrackerConfig::default();
     if let Some(degrees) = TRACKER_ANGLE_DEG.get() {
@@ -291,9 +285,6 @@ fn tracker_config() -> TrackerConfig {
     }
     if let Some(iterations) = TRACKER_ITERATIONS.get() {
         config.iterations = *iterations;
-    }
-    if let Some(weight) = TRACKER_RANGE_CENTRE.get() {
-        config.motion.range_centre = *weight;
     }
     if let Some(on) = TRACKER_KNUCKLE_TIPS.get() {
         config.features.knuckle_tips = *on;
@@ -978,9 +969,6 @@ fn main() -> Result<()> {
     }
     if let Some(on) = args.knuckle_tips {
         let _ = TRACKER_KNUCKLE_TIPS.set(on);
-    }
-    if let Some(weight) = args.range_centre {
-        let _ = TRACKER_RANGE_CENTRE.set(weight);
     }
     if let Some(dark) = args.blackout.clone() {
         return blackout_sweep(&args, &dark);

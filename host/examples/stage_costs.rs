@@ -64,9 +64,6 @@ struct Args {
     /// tracker's), to cost the choice.
     #[arg(long)]
     outermost_share: Option<f32>,
-    /// The prior toward mid-range (per rad²; 0: off; default: the tracker's), to cost it.
-    #[arg(long)]
-    range_centre: Option<f32>,
     /// Whether the tip search also runs beyond knuckles where the outline ends (default: the
     /// tracker's), to cost it.
     #[arg(long)]
@@ -112,9 +109,6 @@ fn main() -> Result<()> {
     }
     if let Some(share) = args.outermost_share {
         config.features.outermost_share = share;
-    }
-    if let Some(weight) = args.range_centre {
-        config.motion.range_centre = weight;
     }
     if let Some(on) = args.knuckle_tips {
         config.features.knuckle_tips = on;

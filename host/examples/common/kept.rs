@@ -71,7 +71,6 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "pj" => c.motion.prior.joint = f,
             "pt" => c.motion.prior.translation = f,
             "pq" => c.motion.prior.quaternion = f,
-            "pmid" => c.motion.range_centre = f,
             "iters" => c.iterations = f as u8,
             "predict" => c.predict = f != 0.0,
             "window" => c.features.window_px = f as u8,
