@@ -65,7 +65,7 @@ pub struct FeatureConfig {
     /// Also search beyond a knuckle where the outline ends there, as beyond a fingertip
     /// (needs `tips`): where the next link, from this camera, turns back over the link or is
     /// seen end-on pointing away ([`ProjectedLink::knuckle_ends`]), as a finger curled away
-    /// from the camera is. On by default: track life +10.1 points mono and +4.9 stereo on 300
+    /// from the camera is. On by default: track life +9.8 points mono and +5.4 stereo on 360
     /// fresh seeds (+22.4 mono from overhead), cost within ±4 % a frame
     /// (`docs/robustness.md`, "Knuckle tips").
     pub knuckle_tips: bool,
