@@ -61,6 +61,34 @@ impl fmt::Display for CameraError {
 impl core::error::Error for CameraError {}
 
 impl Camera {
+    /// A `width`×`height` camera at `eye` (world, mm) looking along `forward`, with
+    /// `up` pointing up the image as far as it can, focal length `focal_px` and the
+    /// principal point at the image's centre. `None` when `forward` is zero or parallel to
+    /// `up`, or the result fails [`Camera::validate`].
+    pub fn looking_along(
+        eye: Vector3<f32>,
+        forward: Vector3<f32>,
+        up: Vector3<f32>,
+        (width, height): (u32, u32),
+        focal_px: f32,
+    ) -> Option<Camera> {
+        let forward = forward.try_normalize(f32::EPSILON)?;
+        let right = forward.cross(&up).try_normalize(f32::EPSILON)?;
+        let down = forward.cross(&right);
+        let r = Matrix3::from_rows(&[right.transpose(), down.transpose(), forward.transpose()]);
+        let camera = Camera {
+            width,
+            height,
+            fx: focal_px,
+            fy: focal_px,
+            cx: (width as f32 - 1.0) * 0.5,
+            cy: (height as f32 - 1.0) * 0.5,
+            r,
+            t: -(r * eye),
+        };
+        camera.validate().ok().map(|()| camera)
+    }
+
     /// Checks the parameters; every camera the tracker uses has passed this.
     pub fn validate(&self) -> Result<(), CameraError> {
         if self.width == 0 || self.height == 0 {

@@ -345,3 +345,30 @@ fn validate_error_paths() {
     // Error texts say what is wrong.
     assert!(CameraError::NotARotation.to_string().contains("rotation"));
 }
+
+#[test]
+fn a_camera_looking_along_a_direction_centres_it_with_up_upward() {
+    let eye = Vector3::new(10.0, -300.0, 50.0);
+    let forward = Vector3::new(0.0, 2.0, 0.0);
+    let camera = Camera::looking_along(eye, forward, Vector3::z(), (640, 480), 800.0).unwrap();
+    assert_eq!(camera.validate(), Ok(()));
+    assert!((camera.centre() - eye).norm() < 1e-3);
+    let ahead = camera
+        .project(&(eye + Vector3::new(0.0, 500.0, 0.0)))
+        .unwrap();
+    assert!((ahead.x - 319.5).abs() < 1e-3 && (ahead.y - 239.5).abs() < 1e-3);
+    let above = camera
+        .project(&(eye + Vector3::new(0.0, 500.0, 40.0)))
+        .unwrap();
+    assert!(above.y < ahead.y - 60.0, "up is up the image: {above:?}");
+    let right = camera
+        .project(&(eye + Vector3::new(40.0, 500.0, 0.0)))
+        .unwrap();
+    assert!(right.x > ahead.x + 60.0, "world x to the right: {right:?}");
+    // No direction, or a direction along `up`: no camera.
+    assert!(
+        Camera::looking_along(eye, Vector3::zeros(), Vector3::z(), (640, 480), 800.0).is_none()
+    );
+    assert!(Camera::looking_along(eye, Vector3::z(), Vector3::z(), (640, 480), 800.0).is_none());
+    assert!(Camera::looking_along(eye, forward, Vector3::z(), (640, 480), 0.0).is_none());
+}

@@ -8,7 +8,10 @@ use digiteyes_core::features::FeatureConfig;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Model;
 use digiteyes_core::projection::{ProjectedLink, ProjectedModel};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
+
+mod common;
+use common::looking_along;
 
 /// Finger 2's joint states: abduction, MCP, PIP, DIP.
 const FINGER_2: [usize; 4] = [11, 12, 13, 14];
@@ -17,28 +20,6 @@ fn straight_hand() -> Vec<f32> {
     let mut q = vec![0.0f32; 28];
     q[0] = 1.0;
     q
-}
-
-/// A camera at `eye` looking along `forward` (unit), 640×480, f = 800 px.
-fn looking_along(eye: Vector3<f32>, forward: Vector3<f32>) -> Camera {
-    let helper = if forward.z.abs() > 0.9 {
-        Vector3::y()
-    } else {
-        Vector3::z()
-    };
-    let right = forward.cross(&helper).normalize();
-    let down = forward.cross(&right);
-    let r = Matrix3::from_rows(&[right.transpose(), down.transpose(), forward.transpose()]);
-    Camera {
-        width: 640,
-        height: 480,
-        fx: 800.0,
-        fy: 800.0,
-        cx: 319.5,
-        cy: 239.5,
-        r,
-        t: -(r * eye),
-    }
 }
 
 /// Finger 2's PIP and DIP points at `q`.

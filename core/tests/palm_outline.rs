@@ -15,7 +15,7 @@ use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Model;
 use digiteyes_core::palm_outline::{convex_hull, HullEdge, PalmOutline};
 use digiteyes_core::projection::{ProjectedLink, ProjectedModel};
-use nalgebra::{Matrix3, Rotation3, Vector2, Vector3};
+use nalgebra::{Rotation3, Vector2, Vector3};
 
 mod common;
 use common::{bent_pose, table_camera};
@@ -35,25 +35,7 @@ fn outline_of(view: &ProjectedModel) -> PalmOutline {
 
 /// A camera at `eye` (mm) looking at `target`, 640×480, f = 800 px.
 fn looking_at(eye: Vector3<f32>, target: Vector3<f32>) -> Camera {
-    let forward = (target - eye).normalize();
-    let helper = if forward.z.abs() > 0.9 {
-        Vector3::y()
-    } else {
-        Vector3::z()
-    };
-    let right = forward.cross(&helper).normalize();
-    let down = forward.cross(&right);
-    let r = Matrix3::from_rows(&[right.transpose(), down.transpose(), forward.transpose()]);
-    Camera {
-        width: 640,
-        height: 480,
-        fx: 800.0,
-        fy: 800.0,
-        cx: 319.5,
-        cy: 239.5,
-        r,
-        t: -(r * eye),
-    }
+    common::looking_along(eye, target - eye)
 }
 
 /// The palm alone at the origin, rotated by `rotation`, every joint 0.

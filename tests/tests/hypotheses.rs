@@ -12,7 +12,7 @@ use digiteyes_core::hypotheses::{HypothesesConfig, MultiTracker};
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::EdgeMap;
 use digiteyes_core::model::Model;
-use digiteyes_core::nalgebra::{Matrix3, Vector3};
+use digiteyes_core::nalgebra::Vector3;
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
 use digiteyes_host::render::{RenderSettings, Renderer};
 use digiteyes_host::sequence::Sequence;
@@ -197,21 +197,7 @@ fn hypotheses_are_scored_one_frame_in_the_period_and_carried_between() {
 
 /// A camera at `eye` looking at `target`, world z up in the image.
 fn look_at(eye: Vector3<f32>, target: Vector3<f32>) -> Camera {
-    let forward = (target - eye).normalize();
-    let up_hint = Vector3::new(0.0, 0.0, 1.0);
-    let right = forward.cross(&up_hint).normalize();
-    let down = forward.cross(&right);
-    let r = Matrix3::from_rows(&[right.transpose(), down.transpose(), forward.transpose()]);
-    Camera {
-        width: 320,
-        height: 240,
-        fx: 500.0,
-        fy: 500.0,
-        cx: 159.5,
-        cy: 119.5,
-        r,
-        t: -(r * eye),
-    }
+    Camera::looking_along(eye, target - eye, Vector3::z(), (320, 240), 500.0).unwrap()
 }
 
 /// Finger 2 (MCP frame 11, tip 14) bends while seen end-on from beyond its tip, then the

@@ -8,25 +8,17 @@
 
 use digiteyes_core::camera::Camera;
 use digiteyes_core::estimator::FreeMask;
-use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Model;
-use digiteyes_core::nalgebra::{Matrix3, Vector3};
+use digiteyes_core::nalgebra::Vector3;
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
 use digiteyes_host::render::{RenderSettings, Renderer};
-use image::GrayImage;
+
+mod common;
+use common::frames::views;
 
 /// Finger 2's joint states: abduction, MCP, PIP, DIP.
 const FINGER_2: [usize; 4] = [11, 12, 13, 14];
-
-fn view(image: &GrayImage) -> FrameView<'_> {
-    FrameView::packed(
-        image.as_raw(),
-        image.width() as usize,
-        image.height() as usize,
-    )
-    .unwrap()
-}
 
 /// A camera 450 mm behind finger 2's PIP, looking along its middle link at `q`, 320×240.
 fn along_middle_link(model: &Model, q: &[f32]) -> Camera {
@@ -34,25 +26,12 @@ fn along_middle_link(model: &Model, q: &[f32]) -> Camera {
     let origin = |s: usize| poses.origin(model.joint_frame(s).unwrap()).unwrap();
     let (pip, dip) = (origin(FINGER_2[2]), origin(FINGER_2[3]));
     let forward = (dip - pip).normalize();
-    let eye = pip - forward * 450.0;
-    let helper = if forward.z.abs() > 0.9 {
+    let up = if forward.z.abs() > 0.9 {
         Vector3::y()
     } else {
         Vector3::z()
     };
-    let right = forward.cross(&helper).normalize();
-    let down = forward.cross(&right);
-    let r = Matrix3::from_rows(&[right.transpose(), down.transpose(), forward.transpose()]);
-    Camera {
-        width: 320,
-        height: 240,
-        fx: 400.0,
-        fy: 400.0,
-        cx: 159.5,
-        cy: 119.5,
-        r,
-        t: -(r * eye),
-    }
+    Camera::looking_along(pip - forward * 450.0, forward, up, (320, 240), 400.0).unwrap()
 }
 
 /// Tracks 120 frames of the still `truth` from `start` with `config`; finger 2's MCP error at
@@ -75,7 +54,7 @@ fn mcp_error_after(
     .unwrap();
     for k in 0..120 {
         let image = renderer.render(truth, k).unwrap();
-        tracker.track(&[view(&image)]).unwrap();
+        tracker.track(&views(std::slice::from_ref(&image))).unwrap();
     }
     (tracker.state()[FINGER_2[1]] - truth[FINGER_2[1]]).abs()
 }

@@ -159,25 +159,8 @@ fn end_on_camera(model: &Model, q: &[f32]) -> Camera {
     let tip = poses.origin(14).unwrap();
     let axis = (tip - base).normalize();
     let eye = tip + axis * 400.0 + digiteyes_core::nalgebra::Vector3::new(0.0, 0.0, 30.0);
-    let forward = (base - eye).normalize();
-    let up_hint = digiteyes_core::nalgebra::Vector3::new(0.0, 0.0, 1.0);
-    let right = forward.cross(&up_hint).normalize();
-    let down = forward.cross(&right);
-    let r = digiteyes_core::nalgebra::Matrix3::from_rows(&[
-        right.transpose(),
-        down.transpose(),
-        forward.transpose(),
-    ]);
-    Camera {
-        width: 320,
-        height: 240,
-        fx: 500.0,
-        fy: 500.0,
-        cx: 159.5,
-        cy: 119.5,
-        r,
-        t: -(r * eye),
-    }
+    let up = digiteyes_core::nalgebra::Vector3::z();
+    Camera::looking_along(eye, base - eye, up, (320, 240), 500.0).unwrap()
 }
 
 /// The renderer of `end_on_camera`'s frames (2× supersampled, noise σ 3).

@@ -56,3 +56,14 @@ pub fn bent_pose() -> Vec<f32> {
     }
     q
 }
+
+/// A 640×480 camera (f = 800 px) at `eye` looking along `forward`, world z up the image (y
+/// when looking nearly straight down or up).
+pub fn looking_along(eye: Vector3<f32>, forward: Vector3<f32>) -> Camera {
+    let up = if forward.normalize().z.abs() > 0.9 {
+        Vector3::y()
+    } else {
+        Vector3::z()
+    };
+    Camera::looking_along(eye, forward, up, (640, 480), 800.0).unwrap()
+}
