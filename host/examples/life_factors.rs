@@ -7,9 +7,18 @@
 //! each factor's rank correlation with life (Spearman) and the median life in the factor's
 //! lower, middle and upper thirds.
 //!
+//! With `--information`, one more factor, of what the images can tell at all: every
+//! `--every`th frame the tracker is put at the truth and runs one iteration of its own
+//! search; a joint whose information there (the diagonal of `JᵀWJ` without the prior, px² per
+//! rad²) is under the prior's weight is *left to the prior*: the image would move it less
+//! than half the way to what it shows. The factor is the share of joint-frames left to the
+//! prior; a table gives that share by kind of joint (abduction, MCP, PIP, DIP, the thumb's
+//! five) per group and per third of the first camera's elevation.
+//!
 //! ```text
 //! digiteyes bench robustness --seeds 60 --frames 200 --first-seed N --keep /tmp/kN
-//! cargo run --release -p digiteyes-host --example life_factors -- /tmp/kN [/tmp/kM ...]
+//! cargo run --release -p digiteyes-host --example life_factors -- /tmp/kN [/tmp/kM ...] \
+//!     [--list] [--information]
 //! ```
 
 use std::path::PathBuf;
@@ -17,6 +26,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Parser;
 use digiteyes_core::kinematics::Poses;
+use digiteyes_core::model::BASE_STATES;
 use digiteyes_core::nalgebra::{Matrix3, Vector3};
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_core::visibility::{cover, Cover};
@@ -24,6 +34,10 @@ use digiteyes_host::eval::stats::percentile;
 use digiteyes_host::eval::{reprojection_error, track_life};
 use digiteyes_host::scenarios::random::random_scenario;
 use digiteyes_host::sequence::{read_states, Sequence};
+use digiteyes_host::{sequence_tracker, TrackerConfig};
+
+/// The thumb's first joint (`q23`): the four fingers' joints come before it, four each.
+const THUMB_FIRST: usize = 23;
 
 #[path = "common/kept.rs"]
 mod kept;
@@ -36,10 +50,17 @@ struct Args {
     /// Also print every seed's life and factors (in the order of the table).
     #[arg(long)]
     list: bool,
+    /// Also measure the joints the images leave to the prior, at the truth (slower: one
+    /// tracker iteration per sampled frame).
+    #[arg(long)]
+    information: bool,
+    /// With `--information`: sample every this many frames.
+    #[arg(long, default_value_t = 5)]
+    every: usize,
 }
 
 /// The factors, in the order they are printed.
-const FACTORS: [&str; 12] = [
+const FACTORS: [&str; 13] = [
     "elevation deg",
     "azimuth from fingertips deg",
     "hand span px",
@@ -52,12 +73,27 @@ const FACTORS: [&str; 12] = [
     "tips hidden share",
     "joint swing rad",
     "palm travel mm",
+    "joints left to the prior",
 ];
+
+/// What the images tell of each kind of joint ([`KINDS`]) at the truth.
+#[derive(Default)]
+struct Information {
+    /// Joint-frames left to the prior, and joint-frames sampled.
+    left: [(usize, usize); KINDS.len()],
+    /// The information of each sampled joint-frame (px² per rad²).
+    values: [Vec<f64>; KINDS.len()],
+}
+
+/// The kinds of joint `--information` splits by: a finger's four, then the thumb's five.
+const KINDS: [&str; 5] = ["abduction", "MCP", "PIP", "DIP", "thumb"];
 
 struct Seed {
     stereo: bool,
     life: f64,
     factors: [f64; FACTORS.len()],
+    /// Per kind of joint, with `--information`.
+    information: Information,
 }
 
 fn main() -> Result<()> {
@@ -66,7 +102,7 @@ fn main() -> Result<()> {
     for dir in &args.dirs {
         for seed_dir in kept::seed_dirs(dir)? {
             let seed = kept::seed_of(&seed_dir);
-            let measured = measure(seed, &seed_dir)?;
+            let measured = measure(seed, &seed_dir, args.information.then_some(args.every))?;
             if args.list {
                 let factors: Vec<String> =
                     measured.factors.iter().map(|f| format!("{f:.2}")).collect();
@@ -102,11 +138,90 @@ fn main() -> Result<()> {
                 100.0 * thirds[2]
             );
         }
+        if args.information {
+            left_table(&group);
+        }
     }
     Ok(())
 }
 
-fn measure(seed: u64, dir: &std::path::Path) -> Result<Seed> {
+/// The share of joint-frames left to the prior, by kind of joint, over `group` and over each
+/// third of it by the first camera's elevation.
+fn left_table(group: &[&Seed]) {
+    let share = |seeds: &[&Seed]| -> Vec<String> {
+        (0..KINDS.len())
+            .map(|k| {
+                let (left, all) = seeds.iter().fold((0, 0), |(l, a), s| {
+                    (l + s.information.left[k].0, a + s.information.left[k].1)
+                });
+                format!("{:>9.0} %", 100.0 * left as f64 / all.max(1) as f64)
+            })
+            .collect()
+    };
+    println!(
+        "  joints left to the prior    {}",
+        KINDS.map(|k| format!("{k:>11}")).join("")
+    );
+    println!("  all                      {}", share(group).join(" "));
+    let medians: Vec<String> = (0..KINDS.len())
+        .map(|k| {
+            let all: Vec<f64> = group
+                .iter()
+                .flat_map(|s| s.information.values[k].iter().copied())
+                .collect();
+            format!("{:>11.0}", percentile(&all, 0.5))
+        })
+        .collect();
+    println!("  median information px²/rad²{}", medians.join(""));
+    let mut order: Vec<&Seed> = group.to_vec();
+    order.sort_by(|a, b| a.factors[0].total_cmp(&b.factors[0]));
+    let n = order.len();
+    for (t, name) in ["low", "mid", "high"].iter().enumerate() {
+        let part = &order[t * n / 3..(t + 1) * n / 3];
+        println!("  elevation {name:<5} third     {}", share(part).join(" "));
+    }
+}
+
+/// Joint-frames left to the prior, per kind of joint ([`KINDS`]): every `every`th frame of
+/// `sequence`, the tracker put at the truth runs one iteration, and a free joint whose
+/// information is under the prior's weight counts as left to it.
+fn left_to_prior(sequence: &Sequence, truth: &[Vec<f32>], every: usize) -> Result<Information> {
+    let mut config = TrackerConfig::default();
+    config.iterations = 1;
+    let prior = config.motion.prior.joint;
+    let mut tracker = sequence_tracker(sequence, config)?;
+    let free = tracker.free();
+    let mut left = [(0usize, 0usize); KINDS.len()];
+    let mut information: [Vec<f64>; KINDS.len()] = Default::default();
+    for (k, state) in truth.iter().enumerate().step_by(every.max(1)) {
+        tracker.reset(state)?;
+        let images = kept::read_instant(sequence, k)?;
+        tracker.track(&kept::views(&images)?)?;
+        let normal = tracker.normal_equations();
+        for j in BASE_STATES..sequence.n_states() {
+            if !free.contains(j) {
+                continue;
+            }
+            let kind = if j >= THUMB_FIRST {
+                4
+            } else {
+                (j - BASE_STATES) % 4
+            };
+            let seen = normal.element(j, j) - prior;
+            information[kind].push(f64::from(seen));
+            left[kind].1 += 1;
+            if seen < prior {
+                left[kind].0 += 1;
+            }
+        }
+    }
+    Ok(Information {
+        left,
+        values: information,
+    })
+}
+
+fn measure(seed: u64, dir: &std::path::Path, information: Option<usize>) -> Result<Seed> {
     let stereo = seed.is_multiple_of(2);
     let scenario = random_scenario(seed, stereo);
     let sequence = Sequence::open(dir)?;
@@ -168,6 +283,12 @@ fn measure(seed: u64, dir: &std::path::Path) -> Result<Seed> {
         spread.iter().sum::<f64>() / spread.len().max(1) as f64
     };
     let turn = scenario.rotation.map_or(0.0, |r| r[0].to_degrees());
+    let information = match information {
+        Some(every) => left_to_prior(&sequence, &truth, every)?,
+        None => Information::default(),
+    };
+    let left = &information.left;
+    let (left_all, joints_all) = left.iter().fold((0, 0), |(l, a), k| (l + k.0, a + k.1));
     Ok(Seed {
         stereo,
         life: track_life(&errors),
@@ -184,7 +305,9 @@ fn measure(seed: u64, dir: &std::path::Path) -> Result<Seed> {
             hidden as f64 / tips.max(1) as f64,
             swing(7..sequence.n_states()),
             swing(4..7),
+            left_all as f64 / joints_all.max(1) as f64,
         ],
+        information,
     })
 }
 
