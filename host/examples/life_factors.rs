@@ -11,7 +11,8 @@
 //! `--every`th frame the tracker is put at the truth and runs one iteration of its own
 //! search; a joint whose information there (the diagonal of `JᵀWJ` without the prior, px² per
 //! rad²) is under the prior's weight is *left to the prior*: the image would move it less
-//! than half the way to what it shows. The factor is the share of joint-frames left to the
+//! than half the way to what it shows (the diagonal overstates what the images tell a joint
+//! apart from its neighbours and the palm, so the shares are lower bounds). The factor is the share of joint-frames left to the
 //! prior; a table gives that share by kind of joint (abduction, MCP, PIP, DIP, the thumb's
 //! five) per group and per third of the first camera's elevation.
 //!
