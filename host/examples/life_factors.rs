@@ -12,9 +12,10 @@
 //! search; a joint whose information there (the diagonal of `JᵀWJ` without the prior, px² per
 //! rad²) is under the prior's weight is *left to the prior*: the image would move it less
 //! than half the way to what it shows (the diagonal overstates what the images tell a joint
-//! apart from its neighbours and the palm, so the shares are lower bounds). The factor is the share of joint-frames left to the
-//! prior; a table gives that share by kind of joint (abduction, MCP, PIP, DIP, the thumb's
-//! five) per group and per third of the first camera's elevation.
+//! apart from its neighbours and the palm, so the shares are lower bounds). The factor is the
+//! share of joint-frames left to the prior; a table gives that share by kind of joint
+//! (abduction, MCP, PIP, DIP, the thumb's five) per group and per third of the first camera's
+//! elevation, and the median information per kind.
 //!
 //! ```text
 //! digiteyes bench robustness --seeds 60 --frames 200 --first-seed N --keep /tmp/kN
@@ -77,13 +78,19 @@ const FACTORS: [&str; 13] = [
     "joints left to the prior",
 ];
 
-/// What the images tell of each kind of joint ([`KINDS`]) at the truth.
-#[derive(Default)]
-struct Information {
-    /// Joint-frames left to the prior, and joint-frames sampled.
-    left: [(usize, usize); KINDS.len()],
-    /// The information of each sampled joint-frame (px² per rad²).
-    values: [Vec<f64>; KINDS.len()],
+/// What the images tell of each kind of joint ([`KINDS`]) at the truth: the information of
+/// each sampled joint-frame (px² per rad²).
+type Information = [Vec<f64>; KINDS.len()];
+
+/// The prior's weight on a joint (px² per rad²): information under it leaves the joint to it.
+fn joint_prior() -> f64 {
+    f64::from(TrackerConfig::default().motion.prior.joint)
+}
+
+/// The share of `values` left to the prior.
+fn left_share(values: &[f64]) -> f64 {
+    let prior = joint_prior();
+    values.iter().filter(|&&v| v < prior).count() as f64 / values.len().max(1) as f64
 }
 
 /// The kinds of joint `--information` splits by: a finger's four, then the thumb's five.
@@ -149,14 +156,15 @@ fn main() -> Result<()> {
 /// The share of joint-frames left to the prior, by kind of joint, over `group` and over each
 /// third of it by the first camera's elevation.
 fn left_table(group: &[&Seed]) {
+    let pooled = |seeds: &[&Seed], k: usize| -> Vec<f64> {
+        seeds
+            .iter()
+            .flat_map(|s| s.information[k].iter().copied())
+            .collect()
+    };
     let share = |seeds: &[&Seed]| -> Vec<String> {
         (0..KINDS.len())
-            .map(|k| {
-                let (left, all) = seeds.iter().fold((0, 0), |(l, a), s| {
-                    (l + s.information.left[k].0, a + s.information.left[k].1)
-                });
-                format!("{:>9.0} %", 100.0 * left as f64 / all.max(1) as f64)
-            })
+            .map(|k| format!("{:>9.0} %", 100.0 * left_share(&pooled(seeds, k))))
             .collect()
     };
     println!(
@@ -165,13 +173,7 @@ fn left_table(group: &[&Seed]) {
     );
     println!("  all                      {}", share(group).join(" "));
     let medians: Vec<String> = (0..KINDS.len())
-        .map(|k| {
-            let all: Vec<f64> = group
-                .iter()
-                .flat_map(|s| s.information.values[k].iter().copied())
-                .collect();
-            format!("{:>11.0}", percentile(&all, 0.5))
-        })
+        .map(|k| format!("{:>11.0}", percentile(&pooled(group, k), 0.5)))
         .collect();
     println!("  median information px²/rad²{}", medians.join(""));
     let mut order: Vec<&Seed> = group.to_vec();
@@ -183,17 +185,20 @@ fn left_table(group: &[&Seed]) {
     }
 }
 
-/// Joint-frames left to the prior, per kind of joint ([`KINDS`]): every `every`th frame of
-/// `sequence`, the tracker put at the truth runs one iteration, and a free joint whose
-/// information is under the prior's weight counts as left to it.
-fn left_to_prior(sequence: &Sequence, truth: &[Vec<f32>], every: usize) -> Result<Information> {
+/// The information of every free joint, per kind ([`KINDS`]): every `every`th frame of
+/// `sequence`, the tracker put at the truth runs one iteration, and each joint's is the
+/// diagonal of that iteration's `JᵀWJ` less the prior's weight.
+fn information_at_truth(
+    sequence: &Sequence,
+    truth: &[Vec<f32>],
+    every: usize,
+) -> Result<Information> {
     let mut config = TrackerConfig::default();
     config.iterations = 1;
     let prior = config.motion.prior.joint;
     let mut tracker = sequence_tracker(sequence, config)?;
     let free = tracker.free();
-    let mut left = [(0usize, 0usize); KINDS.len()];
-    let mut information: [Vec<f64>; KINDS.len()] = Default::default();
+    let mut information = Information::default();
     for (k, state) in truth.iter().enumerate().step_by(every.max(1)) {
         tracker.reset(state)?;
         let images = kept::read_instant(sequence, k)?;
@@ -208,18 +213,10 @@ fn left_to_prior(sequence: &Sequence, truth: &[Vec<f32>], every: usize) -> Resul
             } else {
                 (j - BASE_STATES) % 4
             };
-            let seen = normal.element(j, j) - prior;
-            information[kind].push(f64::from(seen));
-            left[kind].1 += 1;
-            if seen < prior {
-                left[kind].0 += 1;
-            }
+            information[kind].push(f64::from(normal.element(j, j) - prior));
         }
     }
-    Ok(Information {
-        left,
-        values: information,
-    })
+    Ok(information)
 }
 
 fn measure(seed: u64, dir: &std::path::Path, information: Option<usize>) -> Result<Seed> {
@@ -285,11 +282,10 @@ fn measure(seed: u64, dir: &std::path::Path, information: Option<usize>) -> Resu
     };
     let turn = scenario.rotation.map_or(0.0, |r| r[0].to_degrees());
     let information = match information {
-        Some(every) => left_to_prior(&sequence, &truth, every)?,
+        Some(every) => information_at_truth(&sequence, &truth, every)?,
         None => Information::default(),
     };
-    let left = &information.left;
-    let (left_all, joints_all) = left.iter().fold((0, 0), |(l, a), k| (l + k.0, a + k.1));
+    let all_joints: Vec<f64> = information.iter().flatten().copied().collect();
     Ok(Seed {
         stereo,
         life: track_life(&errors),
@@ -306,7 +302,7 @@ fn measure(seed: u64, dir: &std::path::Path, information: Option<usize>) -> Resu
             hidden as f64 / tips.max(1) as f64,
             swing(7..sequence.n_states()),
             swing(4..7),
-            left_all as f64 / joints_all.max(1) as f64,
+            left_share(&all_joints),
         ],
         information,
     })
