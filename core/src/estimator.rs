@@ -41,7 +41,8 @@ pub mod reference;
 
 pub use config::{Conditioning, EstimatorConfig, FreeMask, ResidualKind, Robust};
 pub use jacobian::LinkJacobian;
-pub use link_rows::{add_link_rows, LinkRows};
+pub(crate) use link_rows::add_region_rows;
+pub use link_rows::{add_link_rows, region_row, LinkRows};
 pub use normal::NormalEquations;
 pub use palm_rows::{add_palm_edge_rows, add_reference_palm_edge_rows};
 

@@ -44,6 +44,7 @@ pub mod camera;
 pub mod config;
 pub mod estimator;
 pub mod features;
+pub mod fill;
 pub mod frame;
 pub mod hypotheses;
 pub mod kinematics;

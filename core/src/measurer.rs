@@ -10,6 +10,7 @@
 use crate::camera::Camera;
 use crate::config::MAX_CAMERAS;
 use crate::features::{FeatureConfig, LinkFeatures};
+use crate::fill::{FillConfig, FillPoints};
 use crate::frame::FrameView;
 use crate::palm_outline::HullEdge;
 use crate::projection::ProjectedModel;
@@ -61,6 +62,21 @@ pub trait Measurer {
         view: &ProjectedModel,
         grid: usize,
     ) -> Option<f32>;
+
+    /// The region edge points of `view` (camera number `camera_index`, at the state of this
+    /// iteration) into `out` ([`fill::gather`](crate::fill::gather)). Asked only when
+    /// `config.is_on()`; a measurer without the frames at hand leaves `out` empty.
+    fn fill(
+        &mut self,
+        camera_index: usize,
+        camera: &Camera,
+        view: &ProjectedModel,
+        config: &FillConfig,
+        out: &mut FillPoints,
+    ) {
+        let _ = (camera_index, camera, view, config);
+        out.clear();
+    }
 }
 
 /// The frames of one instant in this process: `frames[i]` is camera `i`'s.
@@ -142,5 +158,19 @@ impl Measurer for LocalFrames<'_, '_> {
     ) -> Option<f32> {
         let frame = self.frames.get(camera_index)?;
         crate::silhouette::score(view, camera, frame, grid).map(|s| s.agreement)
+    }
+
+    fn fill(
+        &mut self,
+        camera_index: usize,
+        camera: &Camera,
+        view: &ProjectedModel,
+        config: &FillConfig,
+        out: &mut FillPoints,
+    ) {
+        match self.frames.get(camera_index) {
+            Some(frame) => crate::fill::gather(view, camera, frame, config, out),
+            None => out.clear(),
+        }
     }
 }

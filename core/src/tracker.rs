@@ -13,10 +13,11 @@ use heapless::Vec;
 use crate::camera::{Camera, CameraError};
 use crate::config::{MAX_CAMERAS, MAX_STATES};
 use crate::estimator::{
-    add_link_rows, add_palm_edge_rows, apply_step, EstimatorConfig, FreeMask, LinkJacobian,
-    NormalEquations, Robust,
+    add_link_rows, add_palm_edge_rows, add_region_rows, apply_step, EstimatorConfig, FreeMask,
+    LinkJacobian, NormalEquations, Robust,
 };
 use crate::features::{FeatureConfig, LinkFeatures};
+use crate::fill::{FillConfig, FillPoints};
 use crate::frame::{FrameError, FrameView};
 use crate::kinematics::{KinematicsError, Poses};
 use crate::measurer::{LocalFrames, Measurer};
@@ -76,6 +77,8 @@ pub struct TrackerConfig {
     pub estimator: EstimatorConfig,
     /// Prediction, prior toward it, and what a lost frame keeps.
     pub motion: MotionConfig,
+    /// Region rows ([`crate::fill`]); off by default.
+    pub fill: FillConfig,
 }
 
 impl Default for TrackerConfig {
@@ -92,6 +95,7 @@ impl Default for TrackerConfig {
             features: FeatureConfig::default(),
             estimator: EstimatorConfig::default(),
             motion: MotionConfig::default(),
+            fill: FillConfig::default(),
         }
     }
 }
@@ -165,6 +169,7 @@ struct Workspace {
     features: LinkFeatures,
     jacobian: LinkJacobian,
     normal: NormalEquations,
+    fill: FillPoints,
 }
 
 /// What a [`Tracker`] knows of one hand between frames: the state, the motion the next
@@ -229,6 +234,7 @@ impl Tracker {
                 features: LinkFeatures::default(),
                 jacobian: LinkJacobian::default(),
                 normal: NormalEquations::new(),
+                fill: FillPoints::default(),
             },
         };
         tracker.reset(initial)?;
@@ -575,6 +581,35 @@ impl Tracker {
         // frame lost, and on the sweep counting them bought nothing (lost recall 0.19 with
         // them, 0.18 without; docs/robustness.md).
         report.rms_px = work.normal.rms();
+        if config.fill.is_on() {
+            for (camera_index, (camera, view)) in
+                self.cameras.iter().zip(work.views.iter()).enumerate()
+            {
+                measurer.fill(camera_index, camera, view, &config.fill, &mut work.fill);
+                for (index, link) in view.links.iter().enumerate() {
+                    let mut points = work
+                        .fill
+                        .points
+                        .iter()
+                        .filter(|p| usize::from(p.link) == index)
+                        .peekable();
+                    if points.peek().is_none() {
+                        continue;
+                    }
+                    work.jacobian
+                        .compute(&self.model, &work.poses, camera, link);
+                    add_region_rows(
+                        &mut work.normal,
+                        link,
+                        points.map(|p| &p.position),
+                        &work.jacobian,
+                        &config.estimator,
+                        self.free,
+                        config.fill.weight,
+                    );
+                }
+            }
+        }
         if config.features.palm_edges {
             for (camera_index, (camera, view)) in
                 self.cameras.iter().zip(work.views.iter()).enumerate()

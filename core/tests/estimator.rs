@@ -102,6 +102,62 @@ fn edge_point_rows_match_finite_differences_on_every_link() {
 }
 
 #[test]
+fn region_rows_match_finite_differences_on_every_link() {
+    let model = Model::hand().unwrap();
+    let cam = camera();
+    let q = pose();
+    let poses = Poses::compute(&model, &q).unwrap();
+    let view = view_at(&model, &q, &cam);
+    let mut jac = LinkJacobian::default();
+    for link in &view.links {
+        jac.compute(&model, &poses, &cam, link);
+        let (dir, normal) = axis_frame(&link.a, &link.b);
+        let r = link.radius_at(0.4);
+        // Beside the axis outside and inside the outline, and beyond each end.
+        let points = [
+            link.a + (link.b - link.a) * 0.4 + normal * (r + 3.0),
+            link.a + (link.b - link.a) * 0.6 - normal * (0.5 * r),
+            link.b + dir * (link.radius_at(1.0) + 2.0),
+            link.a - dir * 1.5 + normal * 0.5,
+        ];
+        for p in points {
+            let (c, residual) = region_row(link, &p).expect("off the axis");
+            let expected = link.radius_at(link.closest(&p).0) - link.closest(&p).1;
+            assert!((residual - expected).abs() < 1e-4);
+            let mut row = Row::new();
+            for (k, &s) in jac.states.iter().enumerate() {
+                let g = [
+                    jac.da[k].x,
+                    jac.da[k].y,
+                    jac.db[k].x,
+                    jac.db[k].y,
+                    jac.dr0[k],
+                    jac.dr1[k],
+                ];
+                let v: f32 = c.iter().zip(&g).map(|(a, b)| a * b).sum();
+                row.push((s, v)).unwrap();
+            }
+            let frame = link.frame;
+            check_row(
+                &model,
+                &q,
+                &row,
+                &|v| {
+                    let l = find(v, frame);
+                    let (s, dist) = l.closest(&p);
+                    l.radius_at(s) - dist
+                },
+                "region",
+            );
+        }
+        assert!(
+            region_row(link, &link.a.lerp(&link.b, 0.5)).is_none(),
+            "on the axis"
+        );
+    }
+}
+
+#[test]
 fn tip_and_line_rows_match_finite_differences() {
     let model = Model::hand().unwrap();
     let cam = camera();

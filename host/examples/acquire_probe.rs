@@ -152,6 +152,9 @@ struct Args {
     /// The tracker's Gauss–Newton iterations per frame (default: the tracker's).
     #[arg(long)]
     tracker_iterations: Option<u8>,
+    /// The weight of the tracker's region rows (0: none; default: the tracker's).
+    #[arg(long)]
+    fill_weight: Option<f32>,
     /// Write every refined leaf's judgement and true error here (CSV).
     #[arg(long)]
     leaves_csv: Option<std::path::PathBuf>,
@@ -270,11 +273,14 @@ static TRACKER_OUTERMOST: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
 /// `main`).
 static TRACKER_KNUCKLE_TIPS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
 
+/// The region rows' weight, when `--fill-weight` gives it (set once in `main`).
+static TRACKER_FILL: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
+
 /// The tracker's iterations, when `--tracker-iterations` gives them (set once in `main`).
 static TRACKER_ITERATIONS: std::sync::OnceLock<u8> = std::sync::OnceLock::new();
 
 /// The tracker's defaults, with `--angle-deg`, `--outermost-share`, `--tracker-iterations`
-/// and `--knuckle-tips` if given.
+/// `--knuckle-tips` and `--fill-weight` if given.
 fn tracker_config() -> TrackerConfig {
     let mut config = TrackerConfig::default();
     if let Some(degrees) = TRACKER_ANGLE_DEG.get() {
@@ -288,6 +294,9 @@ fn tracker_config() -> TrackerConfig {
     }
     if let Some(on) = TRACKER_KNUCKLE_TIPS.get() {
         config.features.knuckle_tips = *on;
+    }
+    if let Some(weight) = TRACKER_FILL.get() {
+        config.fill.weight = *weight;
     }
     config
 }
@@ -969,6 +978,9 @@ fn main() -> Result<()> {
     }
     if let Some(on) = args.knuckle_tips {
         let _ = TRACKER_KNUCKLE_TIPS.set(on);
+    }
+    if let Some(weight) = args.fill_weight {
+        let _ = TRACKER_FILL.set(weight);
     }
     if let Some(dark) = args.blackout.clone() {
         return blackout_sweep(&args, &dark);

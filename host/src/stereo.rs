@@ -31,6 +31,7 @@ use anyhow::{anyhow, ensure, Context, Result};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::features::{FeatureConfig, LinkFeatures};
+use digiteyes_core::fill::FillConfig;
 use digiteyes_core::measurer::Measurer;
 use digiteyes_core::palm_outline::{HullEdge, MAX_HULL_EDGES};
 use digiteyes_core::projection::ProjectedModel;
@@ -390,10 +391,7 @@ pub fn stream_stereo(seq: &Path, out_csv: &Path, options: &StereoOptions) -> Res
         n_cameras <= MAX_BOARDS,
         "at most {MAX_BOARDS} boards, one per camera"
     );
-    let config: TrackerConfig = options
-        .tracker
-        .to_config()
-        .map_err(|e| anyhow!("tracker parameters: {e}"))?;
+    let config: TrackerConfig = boards_config(&options.tracker)?;
     let mut tracker = crate::track::sequence_tracker(&sequence, config)
         .map_err(|e| anyhow!("{}: cannot start the tracker: {e}", seq.display()))?;
     let mut boards = Vec::with_capacity(n_cameras);
@@ -485,6 +483,17 @@ pub fn stream_stereo(seq: &Path, out_csv: &Path, options: &StereoOptions) -> Res
         out: out_csv.to_path_buf(),
         seconds: started.elapsed().as_secs_f64(),
     })
+}
+
+/// The host's solve over boards: `params` as the boards run them, without region rows. The
+/// boards send the features they find, not their frames, and region rows need the pixels
+/// ([`digiteyes_core::fill`]), so the host adds none.
+pub fn boards_config(params: &TrackerParams) -> Result<TrackerConfig> {
+    let mut config = params
+        .to_config()
+        .map_err(|e| anyhow!("tracker parameters: {e}"))?;
+    config.fill = FillConfig::OFF;
+    Ok(config)
 }
 
 /// A tracker configuration as the boards will run it: `config` through the wire form, so

@@ -284,3 +284,65 @@ pub(crate) fn add_weighted_link_rows(
     block.scatter(ne, jac, free);
     added
 }
+
+/// The region row of image point `p` for `link`, as coefficients of the link's image
+/// parameters `a.x, a.y, b.x, b.y, r0, r1`, and its residual: the capsule's mean radius less
+/// the point's distance from the image axis (px; positive inside). Driving it to zero moves
+/// the outline, at its nearest place to the point (a side or an end), through the point:
+/// `∂r = u·((1−s) ∂a + s ∂b) + (1−s) ∂r0 + s ∂r1 + (r̄1 − r̄0) ∂s`, with `u` the unit
+/// direction from the axis to the point and `s` the nearest axis parameter (the last term
+/// only between the ends, where `s` moves with the link). `None`
+/// for a point on the axis, where `u` is undefined.
+pub fn region_row(link: &ProjectedLink, p: &Vector2<f32>) -> Option<([f32; PARAMS], f32)> {
+    let (s, dist) = link.closest(p);
+    if dist.is_nan() || dist < 1e-3 {
+        return None;
+    }
+    let axis = link.b - link.a;
+    let u = (p - (link.a + axis * s)) / dist;
+    let mut c = [
+        (1.0 - s) * u.x,
+        (1.0 - s) * u.y,
+        s * u.x,
+        s * u.y,
+        1.0 - s,
+        s,
+    ];
+    // Between the ends the radius tapers along the axis, so the nearest point's own motion
+    // `∂s = (rel·(∂b − ∂a) − axis·∂a − 2 s axis·(∂b − ∂a)) / len²` adds `taper ∂s`.
+    let len2 = axis.norm_squared();
+    if s > 0.0 && s < 1.0 && len2 > 1e-9 {
+        let taper = (link.radius_at(1.0) - link.radius_at(0.0)) / len2;
+        let rel = p - link.a;
+        let on_b = rel - axis * (2.0 * s);
+        let on_a = -on_b - axis;
+        c[0] += taper * on_a.x;
+        c[1] += taper * on_a.y;
+        c[2] += taper * on_b.x;
+        c[3] += taper * on_b.y;
+    }
+    Some((c, link.radius_at(s) - dist))
+}
+
+/// Adds one [`region_row`] per image point in `points` to `ne`, for `link`, each weighted by
+/// `weight` and the robust weight. Returns the rows added.
+#[inline(never)] // a stage of its own, so profiles can attribute its cost
+pub(crate) fn add_region_rows<'p>(
+    ne: &mut NormalEquations,
+    link: &ProjectedLink,
+    points: impl Iterator<Item = &'p Vector2<f32>>,
+    jac: &LinkJacobian,
+    config: &EstimatorConfig,
+    free: FreeMask,
+    weight: f32,
+) -> u16 {
+    if jac.states.is_empty() {
+        return 0;
+    }
+    let mut block = LinkBlock::new();
+    for (c, r) in points.filter_map(|p| region_row(link, p)) {
+        block.add(&c, r, weight * config.robust.weight(r));
+    }
+    block.scatter(ne, jac, free);
+    block.rows
+}
