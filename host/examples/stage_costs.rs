@@ -68,6 +68,9 @@ struct Args {
     /// tracker's), to cost it.
     #[arg(long)]
     knuckle_tips: Option<bool>,
+    /// The weight of the region rows (0: none; default: the tracker's).
+    #[arg(long)]
+    fill_weight: Option<f32>,
     /// The thesis' plain loop: no motion model, no silhouette check (the cost before them).
     #[arg(long)]
     plain: bool,
@@ -109,6 +112,9 @@ fn main() -> Result<()> {
     }
     if let Some(share) = args.outermost_share {
         config.features.outermost_share = share;
+    }
+    if let Some(weight) = args.fill_weight {
+        config.fill.weight = weight;
     }
     if let Some(on) = args.knuckle_tips {
         config.features.knuckle_tips = on;
