@@ -10,14 +10,18 @@
 //! [`silhouette`](crate::silhouette)). Then
 //!
 //! - a bright sample no part of the model covers, within `reach_px` of a link's outline,
-//!   becomes an edge point of the nearest link on its side: the row pulls that outline out
-//!   to the sample;
-//! - a dark sample a link covers (the nearest link whose capsule contains it) becomes an edge
-//!   point of that link on its side: the row pulls the outline in past it.
+//!   belongs to the nearest link: its row pulls that link's outline out to the sample;
+//! - a dark sample a link covers belongs to the link that covers it most deeply: its row
+//!   pulls the outline in past it.
 //!
-//! Only samples beside a link's axis (projecting onto it between its ends) are used; the
-//! ends are the tip search's. No allocation: the samples live in a caller-owned
-//! [`FillPoints`] of fixed capacity.
+//! Each row moves the outline where it is nearest the sample, a side or an end
+//! ([`region_row`](crate::estimator::region_row)); the palm's samples are left to its outline
+//! edges.
+//!
+//! The samples are gathered on a frame's first iteration and kept, class and link, for its
+//! later ones: a bright sample pulls only while it lies outside its link, a dark one only
+//! while inside ([`region_row`](crate::estimator::region_row)). No allocation: the samples
+//! live in a caller-owned [`FillPoints`] of fixed capacity.
 
 use heapless::Vec;
 use nalgebra::Vector2;
@@ -30,8 +34,8 @@ use crate::silhouette::{hand_bounds, MIN_CLASS_SAMPLES};
 /// Samples along each side of the grid, at most.
 pub const MAX_FILL_GRID: usize = 48;
 
-/// Region edge points kept per camera and iteration, at most (the rest are dropped, counted
-/// in [`FillPoints::dropped`]).
+/// Region samples kept per camera and frame, at most (the rest are dropped, counted in
+/// [`FillPoints::dropped`]).
 pub const MAX_FILL_POINTS: usize = 512;
 
 /// The least contrast between the mean grey level the model covers and the mean it leaves
@@ -58,6 +62,9 @@ pub struct FillConfig {
     pub grid: u8,
     /// A bright uncovered sample pulls an outline only within this distance of it (px).
     pub reach_px: f32,
+    /// A frame's first this many iterations gather the samples afresh at their own state
+    /// (at least 1); the later ones keep the last gathered.
+    pub gather_iterations: u8,
 }
 
 impl Default for FillConfig {
@@ -66,6 +73,7 @@ impl Default for FillConfig {
             weight: 0.1,
             grid: 32,
             reach_px: 12.0,
+            gather_iterations: 1,
         }
     }
 }
@@ -76,6 +84,7 @@ impl FillConfig {
         weight: 0.0,
         grid: 32,
         reach_px: 12.0,
+        gather_iterations: 1,
     };
 
     /// Whether region rows are added.
@@ -84,32 +93,56 @@ impl FillConfig {
     }
 }
 
-/// One region sample, for link `link` of the view.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FillPoint {
-    /// Index of the link in [`ProjectedModel::links`].
-    pub link: u8,
-    /// The sample (px).
-    pub position: Vector2<f32>,
+/// One region sample: a grid cell and the link it belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FillSample {
+    /// The cell, `j × grid + i` ([`FillPoints::position`]).
+    pub cell: u16,
+    /// The model frame of the link the sample belongs to ([`ProjectedLink::frame`]), which
+    /// names the link whatever the view's order at a later iteration.
+    ///
+    /// [`ProjectedLink::frame`]: crate::projection::ProjectedLink::frame
+    pub frame: u8,
+    /// Bright and left uncovered (the link's outline is to reach out to it), or dark and
+    /// covered (the outline is to pull in past it).
+    pub bright: bool,
 }
 
-/// The region edge points of one camera at one state.
+/// The region samples of one camera, gathered on a frame's first iteration and kept for its
+/// later ones (4 bytes a sample).
 #[derive(Debug, Clone, Default)]
 pub struct FillPoints {
-    /// The points, in grid order.
-    pub points: Vec<FillPoint, MAX_FILL_POINTS>,
-    /// Points beyond [`MAX_FILL_POINTS`], not kept.
+    /// The grid's first cell (px).
+    pub origin: Vector2<f32>,
+    /// The grid's spacing (px).
+    pub step: Vector2<f32>,
+    /// Cells along each side of the grid.
+    pub grid: u16,
+    /// The samples, in grid order.
+    pub points: Vec<FillSample, MAX_FILL_POINTS>,
+    /// Samples beyond [`MAX_FILL_POINTS`], not kept.
     pub dropped: u16,
 }
 
 impl FillPoints {
-    /// Empties the points.
+    /// Empties the samples.
     pub fn clear(&mut self) {
         self.points.clear();
         self.dropped = 0;
     }
 
-    fn push(&mut self, point: FillPoint) {
+    /// Where sample `sample` lies in the image (px).
+    pub fn position(&self, sample: &FillSample) -> Vector2<f32> {
+        let grid = self.grid.max(1);
+        let (i, j) = (sample.cell % grid, sample.cell / grid);
+        self.origin
+            + self
+                .step
+                .component_mul(&Vector2::new(f32::from(i), f32::from(j)))
+    }
+
+    fn push(&mut self, point: FillSample) {
         if self.points.push(point).is_err() {
             self.dropped = self.dropped.saturating_add(1);
         }
@@ -185,6 +218,9 @@ pub fn gather(
         return;
     }
     let step = size / (grid - 1) as f32;
+    out.origin = min;
+    out.step = step;
+    out.grid = grid as u16;
     let at =
         |i: usize, j: usize| Vector2::new(min.x + step.x * i as f32, min.y + step.y * j as f32);
     let mut value = [0u8; MAX_FILL_GRID * MAX_FILL_GRID];
@@ -224,10 +260,11 @@ pub fn gather(
                 (OFF_FRAME | PALM | UNCOVERED, _) | (_, true) => None,
                 (_, false) => Some(usize::from(c)),
             };
-            if let Some(index) = link {
-                out.push(FillPoint {
-                    link: index as u8,
-                    position: p,
+            if let Some(link) = link.and_then(|index| view.links.get(index)) {
+                out.push(FillSample {
+                    cell: (j * grid + i) as u16,
+                    frame: link.frame,
+                    bright,
                 });
             }
         }

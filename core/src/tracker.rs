@@ -169,7 +169,8 @@ struct Workspace {
     features: LinkFeatures,
     jacobian: LinkJacobian,
     normal: NormalEquations,
-    fill: FillPoints,
+    /// Each camera's region samples, gathered on a frame's first iteration.
+    fill: [FillPoints; MAX_CAMERAS],
 }
 
 /// What a [`Tracker`] knows of one hand between frames: the state, the motion the next
@@ -234,7 +235,7 @@ impl Tracker {
                 features: LinkFeatures::default(),
                 jacobian: LinkJacobian::default(),
                 normal: NormalEquations::new(),
-                fill: FillPoints::default(),
+                fill: Default::default(),
             },
         };
         tracker.reset(initial)?;
@@ -383,7 +384,7 @@ impl Tracker {
         let mut q = predicted.clone();
         let mut report = FrameReport::default();
         for k in 0..self.config.iterations.max(1) {
-            let Some(step) = self.iterate(&q, &predicted, measurer, k > 0, &mut report) else {
+            let Some(step) = self.iterate(&q, &predicted, measurer, k, &mut report) else {
                 report.lost = true;
                 break;
             };
@@ -521,9 +522,10 @@ impl Tracker {
         q: &[f32],
         predicted: &[f32],
         measurer: &mut M,
-        refine: bool,
+        iteration: u8,
         report: &mut FrameReport,
     ) -> Option<nalgebra::SVector<f32, MAX_STATES>> {
+        let refine = iteration > 0;
         let work = &mut self.work;
         work.poses.update(&self.model, q).ok()?;
         measurer.begin_iteration(q, refine);
@@ -533,8 +535,13 @@ impl Tracker {
         report.features_masked = 0;
         report.links_skipped = 0;
         let config = &self.config;
-        for (camera_index, (camera, view)) in
-            self.cameras.iter().zip(work.views.iter_mut()).enumerate()
+        let fill_on = config.fill.is_on();
+        for (camera_index, ((camera, view), fill)) in self
+            .cameras
+            .iter()
+            .zip(work.views.iter_mut())
+            .zip(work.fill.iter_mut())
+            .enumerate()
         {
             view.update(
                 &self.model,
@@ -542,6 +549,9 @@ impl Tracker {
                 camera,
                 config.features.min_link_px,
             );
+            if fill_on && iteration < config.fill.gather_iterations.max(1) {
+                measurer.fill(camera_index, camera, view, &config.fill, fill);
+            }
             let skipped = view.skipped;
             report.links_skipped += skipped.behind + skipped.end_on + skipped.off_frame;
             for index in 0..view.links.len() {
@@ -559,49 +569,34 @@ impl Tracker {
                 report.features_found += found;
                 report.features_expected += work.features.expected;
                 report.features_masked += work.features.masked;
-                if found == 0 {
+                let link = &view.links[index];
+                let mut samples = fill
+                    .points
+                    .iter()
+                    .filter(|p| fill_on && p.frame == link.frame)
+                    .map(|p| (fill.position(p), p.bright))
+                    .peekable();
+                let region = samples.peek().is_some();
+                if found == 0 && !region {
                     continue;
                 }
-                let link = &view.links[index];
                 work.jacobian
                     .compute(&self.model, &work.poses, camera, link);
-                add_link_rows(
-                    &mut work.normal,
-                    link,
-                    &work.features,
-                    &work.jacobian,
-                    &config.estimator,
-                    self.free,
-                );
-            }
-        }
-        // The lost test weighs the fingers' fit alone: the palm's rows below count neither
-        // towards the found share nor the residual. A palm the image does not show as the
-        // model's bright box (a sleeve, a glove, a renderer's other palm) must not make every
-        // frame lost, and on the sweep counting them bought nothing (lost recall 0.19 with
-        // them, 0.18 without; docs/robustness.md).
-        report.rms_px = work.normal.rms();
-        if config.fill.is_on() {
-            for (camera_index, (camera, view)) in
-                self.cameras.iter().zip(work.views.iter()).enumerate()
-            {
-                measurer.fill(camera_index, camera, view, &config.fill, &mut work.fill);
-                for (index, link) in view.links.iter().enumerate() {
-                    let mut points = work
-                        .fill
-                        .points
-                        .iter()
-                        .filter(|p| usize::from(p.link) == index)
-                        .peekable();
-                    if points.peek().is_none() {
-                        continue;
-                    }
-                    work.jacobian
-                        .compute(&self.model, &work.poses, camera, link);
+                if found > 0 {
+                    add_link_rows(
+                        &mut work.normal,
+                        link,
+                        &work.features,
+                        &work.jacobian,
+                        &config.estimator,
+                        self.free,
+                    );
+                }
+                if region {
                     add_region_rows(
                         &mut work.normal,
                         link,
-                        points.map(|p| &p.position),
+                        samples,
                         &work.jacobian,
                         &config.estimator,
                         self.free,
@@ -610,6 +605,12 @@ impl Tracker {
                 }
             }
         }
+        // The lost test weighs the fingers' fit alone: the palm's rows below count neither
+        // towards the found share nor the residual. A palm the image does not show as the
+        // model's bright box (a sleeve, a glove, a renderer's other palm) must not make every
+        // frame lost, and on the sweep counting them bought nothing (lost recall 0.19 with
+        // them, 0.18 without; docs/robustness.md).
+        report.rms_px = work.normal.rms();
         if config.features.palm_edges {
             for (camera_index, (camera, view)) in
                 self.cameras.iter().zip(work.views.iter()).enumerate()

@@ -69,7 +69,15 @@ fn region_samples_appear_where_the_model_left_its_image() {
     assert!(out
         .points
         .iter()
-        .all(|p| usize::from(p.link) < off.links.len()));
+        .all(|p| off.links.iter().any(|l| l.frame == p.frame)));
+    // Each sample lies on the grid over the hand, inside the frame.
+    for p in &out.points {
+        let at = out.position(p);
+        assert!(
+            frame.sample(at.x, at.y).is_some(),
+            "{at:?} outside the frame"
+        );
+    }
 }
 
 #[test]

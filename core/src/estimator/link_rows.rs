@@ -72,6 +72,18 @@ impl LinkBlock {
     /// Adds `Gᵀ (Σ w c cᵀ) G` and `Gᵀ Σ w r c` to `ne`, over the link's free states. If `G`
     /// is not finite every row would have been, and nothing is added.
     fn scatter(&self, ne: &mut NormalEquations, jac: &LinkJacobian, free: FreeMask) {
+        self.scatter_counted(ne, jac, free, true);
+    }
+
+    /// [`LinkBlock::scatter`], adding the rows to `ne`'s count and sum of squares (its
+    /// [`rms`](NormalEquations::rms)) only when `counted`.
+    fn scatter_counted(
+        &self,
+        ne: &mut NormalEquations,
+        jac: &LinkJacobian,
+        free: FreeMask,
+        counted: bool,
+    ) {
         // `G` by rows over the link's free states (zero-padded to a fixed width, so every
         // loop below is a fixed-length vector operation).
         let mut pos = [0usize; MAX_ROW_NONZEROS];
@@ -97,8 +109,10 @@ impl LinkBlock {
         if zero != 0.0 {
             return;
         }
-        ne.sum_squares += self.sum_squares;
-        ne.rows = ne.rows.saturating_add(self.rows);
+        if counted {
+            ne.sum_squares += self.sum_squares;
+            ne.rows = ne.rows.saturating_add(self.rows);
+        }
         // (Σ w c cᵀ) G and Gᵀ Σ w r c.
         let axpy = |out: &mut [f32; BLOCK], a: f32, x: &[f32; BLOCK]| {
             for (o, v) in out.iter_mut().zip(x) {
@@ -324,13 +338,16 @@ pub fn region_row(link: &ProjectedLink, p: &Vector2<f32>) -> Option<([f32; PARAM
     Some((c, link.radius_at(s) - dist))
 }
 
-/// Adds one [`region_row`] per image point in `points` to `ne`, for `link`, each weighted by
-/// `weight` and the robust weight. Returns the rows added.
+/// Adds one [`region_row`] per region sample in `samples` to `ne`, for `link`, each weighted
+/// by `weight` and the robust weight: `(position, bright)`, where a bright sample counts only
+/// while it lies outside the link (residual < 0) and a dark one only while inside (> 0).
+/// They are left out of `ne`'s row count and residual RMS (the lost test's), as evidence of
+/// another kind than the features'. Returns the rows added.
 #[inline(never)] // a stage of its own, so profiles can attribute its cost
-pub(crate) fn add_region_rows<'p>(
+pub(crate) fn add_region_rows(
     ne: &mut NormalEquations,
     link: &ProjectedLink,
-    points: impl Iterator<Item = &'p Vector2<f32>>,
+    samples: impl Iterator<Item = (Vector2<f32>, bool)>,
     jac: &LinkJacobian,
     config: &EstimatorConfig,
     free: FreeMask,
@@ -340,9 +357,14 @@ pub(crate) fn add_region_rows<'p>(
         return 0;
     }
     let mut block = LinkBlock::new();
-    for (c, r) in points.filter_map(|p| region_row(link, p)) {
-        block.add(&c, r, weight * config.robust.weight(r));
+    for (p, bright) in samples {
+        let Some((c, r)) = region_row(link, &p) else {
+            continue;
+        };
+        if (bright && r < 0.0) || (!bright && r > 0.0) {
+            block.add(&c, r, weight * config.robust.weight(r));
+        }
     }
-    block.scatter(ne, jac, free);
+    block.scatter_counted(ne, jac, free, false);
     block.rows
 }

@@ -88,6 +88,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "fill" => c.fill.weight = f,
             "fillgrid" => c.fill.grid = f as u8,
             "fillreach" => c.fill.reach_px = f,
+            "fillgather" => c.fill.gather_iterations = f as u8,
             "huber" => c.estimator.robust = Robust::Huber(f),
             "tukey" => c.estimator.robust = Robust::Tukey(f),
             "s" => o.hypotheses.score_every_frames = f as u8,
