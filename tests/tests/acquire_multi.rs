@@ -11,6 +11,7 @@ use digiteyes_core::acquire::{AcquireConfig, FinderConfig, LOCAL_VARIANTS};
 use digiteyes_core::auto_tracker::{AutoReport, AutoTracker, Status};
 use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::FreeMask;
+use digiteyes_core::fill::FillConfig;
 use digiteyes_core::hypotheses::{HypothesesConfig, MultiTracker};
 use digiteyes_core::tracker::{Tracker, TrackerConfig};
 use digiteyes_host::sequence::Sequence;
@@ -179,11 +180,12 @@ fn search_frames(
     frames: usize,
     mut each: impl FnMut(usize, &AutoReport, &AutoTracker),
 ) {
-    // With the knuckle tips (on by default since), seed 1751 is held right however the
-    // confirm phase ranks (about 3 px on frames 12-15) and seed 113 carries a single leaf:
-    // off here, to show the confirm phase choosing.
+    // With the knuckle tips or the region rows (both on by default since), seed 1751 is held
+    // right however the confirm phase ranks (about 3 px and 2.5 px on frames 12-15) and seed
+    // 113 carries a single leaf: both off here, to show the confirm phase choosing.
     let mut tracker = TrackerConfig::default();
     tracker.features.knuckle_tips = false;
+    tracker.fill = FillConfig::OFF;
     let (mut auto, mut bufs) = search::searching_with(sequence, AcquireConfig::default(), tracker);
     auto.set_finder(finder);
     for k in 0..frames.min(sequence.frames) {

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use digiteyes_core::acquire::{AcquireConfig, FinderConfig};
 use digiteyes_core::auto_tracker::AutoTracker as CoreAutoTracker;
 use digiteyes_core::estimator::FreeMask;
+use digiteyes_core::fill::FillConfig;
 use digiteyes_core::frame::FrameView;
 use digiteyes_host::acquire::{AutoTracker, Recovery, Status, LOST_FRAMES_BEFORE_SEARCH};
 use digiteyes_host::sequence::{read_states, Sequence};
@@ -266,12 +267,17 @@ fn reacquired_after(
     let truth = sequence.read_truth().unwrap();
     let to_f32 = |q: &[f64]| q.iter().map(|&v| v as f32).collect::<Vec<f32>>();
     let acquire = AcquireConfig::default();
+    // The finder's mechanisms are shown on seeds the tracker once lost; with its region rows
+    // (on by default since) the hand is taken back on them without those mechanisms, so the
+    // rows are off here.
+    let mut tracker = TrackerConfig::default();
+    tracker.fill = FillConfig::OFF;
     let mut auto = CoreAutoTracker::tracking(
         sequence.model.clone(),
         &sequence.cameras,
         &to_f32(&sequence.initial_state),
         FreeMask::all(sequence.n_states()),
-        TrackerConfig::default(),
+        tracker,
         acquire,
     )
     .unwrap();

@@ -4,6 +4,7 @@
 //! sweep's mono seed 1 the variant moved 15 % nearer was refined, accepted and held about
 //! 90 mm nearer the camera than the hand to the end, without the lost flag.
 
+use digiteyes_core::fill::FillConfig;
 use digiteyes_host::bench::robustness::count_run;
 use digiteyes_host::evaluate;
 use digiteyes_host::track::{track_sequence_opts, TrackOptions};
@@ -44,6 +45,9 @@ fn one_cameras_local_re_acquisition_keeps_the_palms_depth() {
     // re-acquisition runs to be judged: off here, where it is.
     let mut config = TrackerConfig::default();
     config.features.knuckle_tips = false;
+    // And with the region rows (on by default since) the variant moved in depth is taken
+    // back to the hand (0 far frames): off too.
+    config.fill = FillConfig::OFF;
     let (far, reacquired) = far_frames(&seq, config, &defaults);
     let mut moved = TrackOptions::default();
     moved.finder.local_depth_share[1] = 0.15;

@@ -10,6 +10,7 @@
 //! The seed is rendered under the fixed light it was found under: with the lighting the sweep
 //! now draws for it, the defect is milder (28° without the palm edges, 21° with them).
 
+use digiteyes_core::fill::FillConfig;
 use digiteyes_core::tracker::TrackerConfig;
 use digiteyes_host::render::Lighting;
 use digiteyes_host::scenarios::{render_scenario, RenderOptions};
@@ -62,6 +63,9 @@ fn the_palm_outline_keeps_seed_39s_palm_where_the_fingers_lie_across_it() {
     // So do the knuckle tips (on by default since: 2.7 deg at most without the palm edges);
     // off here too.
     with.features.knuckle_tips = false;
+    // And so do the region rows (on by default since: 26.8 deg at most without the palm
+    // edges); off here too.
+    with.fill = FillConfig::OFF;
     let mut without = with;
     without.features.palm_edges = false;
     let (on, off) = (

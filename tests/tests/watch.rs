@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use digiteyes_core::fill::FillConfig;
 use digiteyes_core::watch::WatchConfig;
 use digiteyes_host::render::Lighting;
 use digiteyes_host::sequence::read_states;
@@ -89,6 +90,9 @@ fn a_track_the_image_no_longer_supports_is_flagged() {
     // And so with the knuckle tips (on by default since; 0 wrong frames claimed with them):
     // off too.
     config.features.knuckle_tips = false;
+    // And so with the region rows (on by default since; 0 wrong frames claimed with them):
+    // off too.
+    config.fill = FillConfig::OFF;
     let a = dir.path().join("a.csv");
     let (watched, tips) = track_with(&seq, &a, WatchConfig::default(), config);
     let b = dir.path().join("b.csv");
