@@ -1,7 +1,6 @@
 //! The estimator's analytic residual rows against finite differences, the normal equations
 //! against a dense computation, robust weights and the axis-line fit.
 
-use digiteyes_core::camera::Camera;
 use digiteyes_core::estimator::reference::*;
 use digiteyes_core::estimator::*;
 use digiteyes_core::features::{axis_frame, fit_axis_line, EdgePoint, LinkFeatures};
@@ -11,14 +10,7 @@ use digiteyes_core::projection::{ProjectedLink, ProjectedModel};
 use nalgebra::Vector2;
 
 mod common;
-use common::{bent_pose as pose, table_camera as camera};
-
-fn view_at(model: &Model, q: &[f32], camera: &Camera) -> ProjectedModel {
-    let poses = Poses::compute(model, q).unwrap();
-    let mut view = ProjectedModel::new();
-    view.update(model, &poses, camera, 1.0);
-    view
-}
+use common::{bent_pose as pose, table_camera as camera, view_at};
 
 fn find(view: &ProjectedModel, frame: u8) -> &ProjectedLink {
     view.links

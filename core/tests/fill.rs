@@ -5,21 +5,13 @@
 use digiteyes_core::camera::Camera;
 use digiteyes_core::fill::{gather, FillConfig, FillPoints, MAX_FILL_POINTS};
 use digiteyes_core::frame::FrameView;
-use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Model;
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_core::silhouette::covers;
 use nalgebra::Vector2;
 
 mod common;
-use common::{bent_pose, table_camera};
-
-fn view_at(model: &Model, q: &[f32], camera: &Camera) -> ProjectedModel {
-    let poses = Poses::compute(model, q).unwrap();
-    let mut view = ProjectedModel::new();
-    view.update(model, &poses, camera, 1.0);
-    view
-}
+use common::{bent_pose, table_camera, view_at};
 
 /// The model's silhouette at `q`, 200 grey levels on 40.
 fn painted(model: &Model, q: &[f32], camera: &Camera) -> Vec<u8> {

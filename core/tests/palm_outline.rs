@@ -18,14 +18,7 @@ use digiteyes_core::projection::{ProjectedLink, ProjectedModel};
 use nalgebra::{Rotation3, Vector2, Vector3};
 
 mod common;
-use common::{bent_pose, table_camera};
-
-fn view_at(model: &Model, q: &[f32], camera: &Camera) -> ProjectedModel {
-    let poses = Poses::compute(model, q).unwrap();
-    let mut view = ProjectedModel::new();
-    view.update(model, &poses, camera, 1.0);
-    view
-}
+use common::{bent_pose, table_camera, view_at};
 
 fn outline_of(view: &ProjectedModel) -> PalmOutline {
     let mut outline = PalmOutline::new();

@@ -7,16 +7,15 @@
 //! holds what no feature sees, and the knuckle's one row pulls slowly against it.)
 
 use digiteyes_core::camera::Camera;
-use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::fill::FillConfig;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Model;
 use digiteyes_core::nalgebra::Vector3;
-use digiteyes_core::tracker::{Tracker, TrackerConfig};
+use digiteyes_core::tracker::TrackerConfig;
 use digiteyes_host::render::{RenderSettings, Renderer};
 
 mod common;
-use common::frames::views;
+use common::frames::track_still;
 
 /// Finger 2's joint states: abduction, MCP, PIP, DIP.
 const FINGER_2: [usize; 4] = [11, 12, 13, 14];
@@ -35,28 +34,16 @@ fn along_middle_link(model: &Model, q: &[f32]) -> Camera {
     Camera::looking_along(pip - forward * 450.0, forward, up, (320, 240), 400.0).unwrap()
 }
 
-/// Tracks 120 frames of the still `truth` from `start` with `config`; finger 2's MCP error at
-/// the end (rad).
+/// Finger 2's MCP error (rad) after 120 frames of the still `truth` tracked from `start`
+/// under `config`.
 fn mcp_error_after(
-    model: &Model,
     renderer: &Renderer,
+    model: &Model,
     camera: Camera,
-    truth: &[f32],
-    start: &[f32],
+    (truth, start): (&[f32], &[f32]),
     config: TrackerConfig,
 ) -> f32 {
-    let mut tracker = Tracker::new(
-        model.clone(),
-        &[camera],
-        start,
-        FreeMask::all(model.n_states()),
-        config,
-    )
-    .unwrap();
-    for k in 0..120 {
-        let image = renderer.render(truth, k).unwrap();
-        tracker.track(&views(std::slice::from_ref(&image))).unwrap();
-    }
+    let tracker = track_still(renderer, model, camera, (truth, start), config, 120);
     (tracker.state()[FINGER_2[1]] - truth[FINGER_2[1]]).abs()
 }
 
@@ -84,8 +71,8 @@ fn a_finger_curled_away_is_placed_by_its_knuckle() {
     for push in [0.25f32, -0.25] {
         let mut start = truth.clone();
         start[FINGER_2[1]] += push;
-        let on = mcp_error_after(&model, &renderer, camera, &truth, &start, with);
-        let off = mcp_error_after(&model, &renderer, camera, &truth, &start, without);
+        let on = mcp_error_after(&renderer, &model, camera, (&truth, &start), with);
+        let off = mcp_error_after(&renderer, &model, camera, (&truth, &start), without);
         println!("MCP pushed {push:+} rad: {on:.3} rad off after 120 frames with the knuckle tips, {off:.3} without");
         assert!(
             on < 0.25 * off && on < 0.1,

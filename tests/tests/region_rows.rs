@@ -5,16 +5,15 @@
 //! 10.9 mm off after 60 frames with the region rows, 19.5 and 22.2 mm without.)
 
 use digiteyes_core::camera::Camera;
-use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::fill::FillConfig;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::Model;
 use digiteyes_core::nalgebra::Vector3;
-use digiteyes_core::tracker::{Tracker, TrackerConfig};
+use digiteyes_core::tracker::TrackerConfig;
 use digiteyes_host::render::{RenderSettings, Renderer};
 
 mod common;
-use common::frames::views;
+use common::frames::track_still;
 
 /// A camera 450 mm above the palm's origin looking straight down, 320×240.
 fn overhead(model: &Model, q: &[f32]) -> Camera {
@@ -24,28 +23,16 @@ fn overhead(model: &Model, q: &[f32]) -> Camera {
     Camera::looking_along(eye, -Vector3::z(), Vector3::y(), (320, 240), 400.0).unwrap()
 }
 
-/// Tracks 60 frames of the still `truth` from `start` with `config`; the palm's distance
-/// from the truth across the view at the end (mm).
+/// The palm's distance from the truth across the view (mm) after 60 frames of the still
+/// `truth` tracked from `start` under `config`.
 fn palm_error_after(
-    model: &Model,
     renderer: &Renderer,
+    model: &Model,
     camera: Camera,
-    truth: &[f32],
-    start: &[f32],
+    (truth, start): (&[f32], &[f32]),
     config: TrackerConfig,
 ) -> f32 {
-    let mut tracker = Tracker::new(
-        model.clone(),
-        &[camera],
-        start,
-        FreeMask::all(model.n_states()),
-        config,
-    )
-    .unwrap();
-    for k in 0..60 {
-        let image = renderer.render(truth, k).unwrap();
-        tracker.track(&views(std::slice::from_ref(&image))).unwrap();
-    }
+    let tracker = track_still(renderer, model, camera, (truth, start), config, 60);
     let s = tracker.state();
     ((s[4] - truth[4]).powi(2) + (s[5] - truth[5]).powi(2)).sqrt()
 }
@@ -69,8 +56,8 @@ fn a_hand_put_off_its_image_is_pulled_back_by_the_region() {
     for push in [18.0f32, -18.0] {
         let mut start = truth.clone();
         start[4] += push;
-        let on = palm_error_after(&model, &renderer, camera, &truth, &start, with);
-        let off = palm_error_after(&model, &renderer, camera, &truth, &start, without);
+        let on = palm_error_after(&renderer, &model, camera, (&truth, &start), with);
+        let off = palm_error_after(&renderer, &model, camera, (&truth, &start), without);
         println!("palm put {push:+} mm off: {on:.1} mm off after 60 frames with region rows, {off:.1} without");
         assert!(
             on < 0.6 * off && on < 12.0,

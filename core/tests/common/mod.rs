@@ -29,6 +29,9 @@ impl Rng {
 }
 
 use digiteyes_core::camera::Camera;
+use digiteyes_core::kinematics::Poses;
+use digiteyes_core::model::Model;
+use digiteyes_core::projection::ProjectedModel;
 use nalgebra::{Matrix3, Vector3};
 
 const H: f32 = std::f32::consts::FRAC_1_SQRT_2;
@@ -66,4 +69,12 @@ pub fn looking_along(eye: Vector3<f32>, forward: Vector3<f32>) -> Camera {
         Vector3::z()
     };
     Camera::looking_along(eye, forward, up, (640, 480), 800.0).unwrap()
+}
+
+/// The model at `q` projected into `camera`, every link at least 1 px long kept.
+pub fn view_at(model: &Model, q: &[f32], camera: &Camera) -> ProjectedModel {
+    let poses = Poses::compute(model, q).unwrap();
+    let mut view = ProjectedModel::new();
+    view.update(model, &poses, camera, 1.0);
+    view
 }

@@ -45,3 +45,28 @@ pub fn tracker_at(
     )
     .unwrap()
 }
+
+/// A tracker of every state of `model` seen by `camera` alone, started at `start` under
+/// `config`, after `frames` frames of the still `truth` (each rendered with its own noise).
+pub fn track_still(
+    renderer: &digiteyes_host::render::Renderer,
+    model: &digiteyes_core::model::Model,
+    camera: digiteyes_core::camera::Camera,
+    (truth, start): (&[f32], &[f32]),
+    config: digiteyes_core::tracker::TrackerConfig,
+    frames: usize,
+) -> digiteyes_core::tracker::Tracker {
+    let mut tracker = digiteyes_core::tracker::Tracker::new(
+        model.clone(),
+        &[camera],
+        start,
+        digiteyes_core::estimator::FreeMask::all(model.n_states()),
+        config,
+    )
+    .unwrap();
+    for k in 0..frames {
+        let image = renderer.render(truth, k as u64).unwrap();
+        tracker.track(&views(std::slice::from_ref(&image))).unwrap();
+    }
+    tracker
+}
