@@ -12,7 +12,9 @@
 //! - a bright sample no part of the model covers, within `reach_px` of a link's outline,
 //!   belongs to the nearest link: its row pulls that link's outline out to the sample;
 //! - a dark sample a link covers belongs to the link that covers it most deeply: its row
-//!   pulls the outline in past it.
+//!   pulls the outline in past it;
+//! - a sample near the midpoint ([`FillConfig::class_margin`]) is neither: the hand's own
+//!   shaded side is not background.
 //!
 //! Each row moves the outline where it is nearest the sample, a side or an end
 //! ([`region_row`](crate::estimator::region_row)); the palm's samples are left to its outline
@@ -28,7 +30,7 @@ use nalgebra::Vector2;
 
 use crate::camera::Camera;
 use crate::frame::FrameView;
-use crate::projection::ProjectedModel;
+use crate::projection::{ProjectedLink, ProjectedModel};
 use crate::silhouette::{hand_bounds, MIN_CLASS_SAMPLES};
 
 /// Samples along each side of the grid, at most.
@@ -55,8 +57,8 @@ const OFF_FRAME: u8 = u8::MAX - 2;
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FillConfig {
     /// Weight of each region row relative to a slice edge's (0: no region rows, the
-    /// tracker as it was before them, bit for bit). Default 0.1, measured on fresh seeds
-    /// (`docs/robustness.md`, "Region rows").
+    /// tracker as it was before them, bit for bit). Default 1, measured on fresh seeds
+    /// with [`FillConfig::class_margin`] (`docs/robustness.md`, "Region rows").
     pub weight: f32,
     /// Samples along each side of the grid (clamped to 2..=[`MAX_FILL_GRID`]).
     pub grid: u8,
@@ -65,15 +67,30 @@ pub struct FillConfig {
     /// A frame's first this many iterations gather the samples afresh at their own state
     /// (at least 1); the later ones keep the last gathered.
     pub gather_iterations: u8,
+    /// How clearly a sample must be bright or dark to be classed at all, as a share of the
+    /// contrast between the covered and uncovered means: a sample within this share of the
+    /// midpoint between them is left out (0: every sample is classed). Default 0.3: a dark
+    /// sample is then no brighter than the uncovered mean plus 0.2 of the contrast, a bright
+    /// one no darker than the covered mean less 0.2 of it. By the midpoint alone, the hand's
+    /// own shaded side is classed dark under a link at the truth (23 samples a view on the
+    /// sweep, against 0.7 at 0.3; `examples/fill_truth.rs`): rows that pull right links in.
+    pub class_margin: f32,
+    /// A link whose image is shorter than this many times its width has its rows weighed
+    /// down by its length over this many widths ([`FillConfig::link_weight`]; 0: every link
+    /// at full weight). Default 1: a finger seen end-on is the thesis' singular
+    /// configuration, whose outline says little of how its bend is split among its joints.
+    pub full_length_widths: f32,
 }
 
 impl Default for FillConfig {
     fn default() -> Self {
         FillConfig {
-            weight: 0.1,
+            weight: 1.0,
             grid: 32,
             reach_px: 12.0,
             gather_iterations: 1,
+            class_margin: 0.3,
+            full_length_widths: 1.0,
         }
     }
 }
@@ -85,11 +102,24 @@ impl FillConfig {
         grid: 32,
         reach_px: 12.0,
         gather_iterations: 1,
+        class_margin: 0.3,
+        full_length_widths: 1.0,
     };
 
     /// Whether region rows are added.
     pub fn is_on(&self) -> bool {
         self.weight > 0.0
+    }
+
+    /// The weight of `link`'s region rows: [`FillConfig::weight`], times its image length
+    /// over [`FillConfig::full_length_widths`] of its image widths when shorter.
+    pub fn link_weight(&self, link: &ProjectedLink) -> f32 {
+        let widths = self.full_length_widths * link.mean_width_px();
+        if widths > 0.0 {
+            self.weight * ((link.b - link.a).norm() / widths).min(1.0)
+        } else {
+            self.weight
+        }
     }
 }
 
@@ -250,10 +280,15 @@ pub fn gather(
         return;
     }
     let threshold = 0.5 * (covered + uncovered);
+    let margin = config.class_margin.max(0.0) * contrast;
     for j in 0..grid {
         for i in 0..grid {
             let c = class[j * grid + i];
-            let bright = f32::from(value[j * grid + i]) > threshold;
+            let v = f32::from(value[j * grid + i]);
+            if (v - threshold).abs() < margin {
+                continue;
+            }
+            let bright = v > threshold;
             let p = at(i, j);
             let link = match (c, bright) {
                 (UNCOVERED, true) => nearest_outline(view, &p, reach),

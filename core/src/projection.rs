@@ -136,6 +136,11 @@ impl ProjectedLink {
         0.5 * (self.side_radius_at(s, 1) + self.side_radius_at(s, -1))
     }
 
+    /// The capsule's image width, side to side, averaged over its two ends (px).
+    pub fn mean_width_px(&self) -> f32 {
+        0.5 * (self.r0[0] + self.r0[1] + self.r1[0] + self.r1[1])
+    }
+
     /// Distance from the image axis to the silhouette on side `side` (+1 along the normal
     /// `(−d_y, d_x)`, −1 opposite) at axis parameter `s` (px).
     pub fn side_radius_at(&self, s: f32, side: i8) -> f32 {

@@ -77,7 +77,7 @@ pub struct TrackerConfig {
     pub estimator: EstimatorConfig,
     /// Prediction, prior toward it, and what a lost frame keeps.
     pub motion: MotionConfig,
-    /// Region rows ([`crate::fill`]); off by default.
+    /// Region rows ([`crate::fill`]); on by default.
     pub fill: FillConfig,
 }
 
@@ -600,7 +600,7 @@ impl Tracker {
                         &work.jacobian,
                         &config.estimator,
                         self.free,
-                        config.fill.weight,
+                        config.fill.link_weight(link),
                     );
                 }
             }

@@ -94,3 +94,93 @@ fn nothing_is_gathered_without_a_hand_in_view_or_with_one_class_only() {
     assert!(out.points.is_empty());
     assert_eq!(out.dropped, 0);
 }
+
+/// The model's silhouette at `q` with its left half lit (200) and its right half in shade
+/// (90, darker than the midpoint between the covered and uncovered means), on 40.
+fn painted_with_shade(model: &Model, q: &[f32], camera: &Camera) -> Vec<u8> {
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let view = view_at(model, q, camera);
+    let covered: Vec<bool> = (0..w * h)
+        .map(|i| covers(&view, camera, &Vector2::new((i % w) as f32, (i / w) as f32)))
+        .collect();
+    let (sum, count) = covered
+        .iter()
+        .enumerate()
+        .filter(|(_, &c)| c)
+        .fold((0usize, 0usize), |(s, n), (i, _)| (s + i % w, n + 1));
+    let centre = sum / count.max(1);
+    covered
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| match (c, i % w < centre) {
+            (false, _) => 40,
+            (true, true) => 200,
+            (true, false) => 90,
+        })
+        .collect()
+}
+
+#[test]
+fn the_hands_own_shade_is_not_background() {
+    let model = Model::hand().unwrap();
+    let camera = table_camera();
+    let truth = bent_pose();
+    let pixels = painted_with_shade(&model, &truth, &camera);
+    let frame = FrameView::packed(&pixels, camera.width as usize, camera.height as usize).unwrap();
+    let mut out = FillPoints::default();
+    let dark = |out: &FillPoints| out.points.iter().filter(|p| !p.bright).count();
+
+    let at_truth = view_at(&model, &truth, &camera);
+    let midpoint = FillConfig {
+        class_margin: 0.0,
+        ..FillConfig::default()
+    };
+    gather(&at_truth, &camera, &frame, &midpoint, &mut out);
+    let shade_by_midpoint = dark(&out);
+    gather(&at_truth, &camera, &frame, &FillConfig::default(), &mut out);
+    let shade_by_margin = dark(&out);
+
+    let mut moved = truth.clone();
+    moved[4] += 8.0; // mm across the view
+    let off = view_at(&model, &moved, &camera);
+    gather(&off, &camera, &frame, &FillConfig::default(), &mut out);
+    let off_image = out.points.len();
+    println!(
+        "dark samples at the truth: {shade_by_midpoint} by the midpoint, {shade_by_margin} with \
+         the margin; {off_image} samples moved 8 mm off"
+    );
+    assert!(
+        shade_by_midpoint > 20,
+        "{shade_by_midpoint} shaded samples by the midpoint alone"
+    );
+    assert!(
+        shade_by_margin * 10 < shade_by_midpoint,
+        "{shade_by_margin} shaded samples classed dark with the margin"
+    );
+    assert!(off_image > 40, "{off_image} samples moved off the image");
+}
+
+#[test]
+fn a_foreshortened_links_rows_are_weighed_down_by_length_over_width() {
+    let model = Model::hand().unwrap();
+    let camera = table_camera();
+    let view = view_at(&model, &bent_pose(), &camera);
+    let config = FillConfig::default();
+    let mut link = view.links[0];
+    let width = link.mean_width_px();
+    assert!(width > 0.0);
+    let (direction, _) = link.axis_frame();
+    for (length_widths, expected) in [(3.0f32, 1.0f32), (1.0, 1.0), (0.5, 0.5), (0.0, 0.0)] {
+        link.b = link.a + direction * (length_widths * width);
+        let weight = config.link_weight(&link);
+        assert!(
+            (weight - config.weight * expected).abs() < 1e-4,
+            "a link {length_widths} widths long weighs {weight}"
+        );
+    }
+    let every_link = FillConfig {
+        full_length_widths: 0.0,
+        ..config
+    };
+    assert_eq!(every_link.link_weight(&link), config.weight);
+}

@@ -155,6 +155,17 @@ struct Args {
     /// The weight of the tracker's region rows (0: none; default: the tracker's).
     #[arg(long)]
     fill_weight: Option<f32>,
+    /// The tracker's region rows gathered afresh on this many of a frame's first iterations
+    /// (default: the tracker's).
+    #[arg(long)]
+    fill_gather: Option<u8>,
+    /// The region rows' class margin (share of the contrast; default: the tracker's).
+    #[arg(long)]
+    fill_margin: Option<f32>,
+    /// The region rows' full-weight length in widths (0: every link at full weight;
+    /// default: the tracker's).
+    #[arg(long)]
+    fill_full_length: Option<f32>,
     /// Write every refined leaf's judgement and true error here (CSV).
     #[arg(long)]
     leaves_csv: Option<std::path::PathBuf>,
@@ -276,11 +287,21 @@ static TRACKER_KNUCKLE_TIPS: std::sync::OnceLock<bool> = std::sync::OnceLock::ne
 /// The region rows' weight, when `--fill-weight` gives it (set once in `main`).
 static TRACKER_FILL: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
 
+/// The region rows' gathering iterations, when `--fill-gather` gives them (set once in `main`).
+static TRACKER_FILL_GATHER: std::sync::OnceLock<u8> = std::sync::OnceLock::new();
+
+/// The region rows' class margin, when `--fill-margin` gives it (set once in `main`).
+static TRACKER_FILL_MARGIN: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
+
+/// The region rows' full-weight length, when `--fill-full-length` gives it (set once in `main`).
+static TRACKER_FILL_LENGTH: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
+
 /// The tracker's iterations, when `--tracker-iterations` gives them (set once in `main`).
 static TRACKER_ITERATIONS: std::sync::OnceLock<u8> = std::sync::OnceLock::new();
 
-/// The tracker's defaults, with `--angle-deg`, `--outermost-share`, `--tracker-iterations`
-/// `--knuckle-tips` and `--fill-weight` if given.
+/// The tracker's defaults, with `--angle-deg`, `--outermost-share`, `--tracker-iterations`,
+/// `--knuckle-tips`, `--fill-weight`, `--fill-gather`, `--fill-margin` and
+/// `--fill-full-length` if given.
 fn tracker_config() -> TrackerConfig {
     let mut config = TrackerConfig::default();
     if let Some(degrees) = TRACKER_ANGLE_DEG.get() {
@@ -297,6 +318,15 @@ fn tracker_config() -> TrackerConfig {
     }
     if let Some(weight) = TRACKER_FILL.get() {
         config.fill.weight = *weight;
+    }
+    if let Some(n) = TRACKER_FILL_GATHER.get() {
+        config.fill.gather_iterations = *n;
+    }
+    if let Some(margin) = TRACKER_FILL_MARGIN.get() {
+        config.fill.class_margin = *margin;
+    }
+    if let Some(widths) = TRACKER_FILL_LENGTH.get() {
+        config.fill.full_length_widths = *widths;
     }
     config
 }
@@ -981,6 +1011,15 @@ fn main() -> Result<()> {
     }
     if let Some(weight) = args.fill_weight {
         let _ = TRACKER_FILL.set(weight);
+    }
+    if let Some(n) = args.fill_gather {
+        let _ = TRACKER_FILL_GATHER.set(n);
+    }
+    if let Some(margin) = args.fill_margin {
+        let _ = TRACKER_FILL_MARGIN.set(margin);
+    }
+    if let Some(widths) = args.fill_full_length {
+        let _ = TRACKER_FILL_LENGTH.set(widths);
     }
     if let Some(dark) = args.blackout.clone() {
         return blackout_sweep(&args, &dark);

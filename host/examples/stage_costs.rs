@@ -71,6 +71,13 @@ struct Args {
     /// The weight of the region rows (0: none; default: the tracker's).
     #[arg(long)]
     fill_weight: Option<f32>,
+    /// The region rows' class margin (share of the contrast; default: the tracker's).
+    #[arg(long)]
+    fill_margin: Option<f32>,
+    /// The region rows' full-weight length in widths (0: every link at full weight; default:
+    /// the tracker's).
+    #[arg(long)]
+    fill_full_length: Option<f32>,
     /// The thesis' plain loop: no motion model, no silhouette check (the cost before them).
     #[arg(long)]
     plain: bool,
@@ -115,6 +122,12 @@ fn main() -> Result<()> {
     }
     if let Some(weight) = args.fill_weight {
         config.fill.weight = weight;
+    }
+    if let Some(margin) = args.fill_margin {
+        config.fill.class_margin = margin;
+    }
+    if let Some(widths) = args.fill_full_length {
+        config.fill.full_length_widths = widths;
     }
     if let Some(on) = args.knuckle_tips {
         config.features.knuckle_tips = on;

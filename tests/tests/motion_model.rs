@@ -228,8 +228,10 @@ fn a_finger_seen_end_on_keeps_its_joints() {
         println!("robust, joint prior 8000 {:.3}", run(c));
     }
     // The prior alone: the region rows (on by default) are off here. With them this finger
-    // wanders 0.122 rad over the 30 frames (docs/robustness.md, "Region rows"): the rows of
-    // its foreshortened links pull along what the slices cannot see.
+    // wanders 0.103 rad over the 30 frames (docs/robustness.md, "Region rows"): the rows of
+    // its foreshortened links pull along what the slices cannot see. At full weight on every
+    // link (`FillConfig::full_length_widths` 0) it wanders 0.418 rad; the rows of a link
+    // shorter in the image than its width are weighed down by length over width.
     let mut prior_alone = robust_config();
     prior_alone.fill = FillConfig::OFF;
     let robust = run(prior_alone);

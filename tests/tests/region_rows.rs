@@ -1,8 +1,9 @@
 //! The region rows (`TrackerConfig::fill`, issue 9) on rendered frames: a hand placed
 //! sideways off its image, farther than the slice windows reach, finds edges that are not its
 //! own and stays about as far off as it was put; the bright pixels it leaves uncovered pull
-//! it back. (Measured on this still, overhead view: put 18 mm off, the palm ends 7.2 and
-//! 10.9 mm off after 60 frames with the region rows, 19.5 and 22.2 mm without.)
+//! it back. (Measured on this still, overhead view: put 18 mm off, the palm ends 0.7 and
+//! 9.6 mm off after 60 frames with the region rows, 19.5 and 22.2 mm without; 7.2 and
+//! 10.9 mm under the rows' first defaults, weight 0.1 and no class margin.)
 
 use digiteyes_core::camera::Camera;
 use digiteyes_core::fill::FillConfig;

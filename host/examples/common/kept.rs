@@ -89,6 +89,8 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "fillgrid" => c.fill.grid = f as u8,
             "fillreach" => c.fill.reach_px = f,
             "fillgather" => c.fill.gather_iterations = f as u8,
+            "fillmargin" => c.fill.class_margin = f,
+            "fillend" => c.fill.full_length_widths = f,
             "lostrms" => c.lost_rms_px = f,
             "sdrop" => c.lost_silhouette_drop = f,
             "minfound" => c.lost_min_found = f,
