@@ -4,7 +4,7 @@
 //! joint pushed `--push-rad` (alternating signs), per camera, bright and dark apart.
 //!
 //! ```text
-//! cargo run --release -p digiteyes-host --example fill_truth -- /tmp/keep [--set fillmargin=0.2]
+//! cargo run --release -p digiteyes-host --example fill_truth -- /tmp/keep [--set fillmargin=0]
 //! ```
 
 use std::path::PathBuf;
