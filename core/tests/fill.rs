@@ -13,19 +13,20 @@ use nalgebra::Vector2;
 mod common;
 use common::{bent_pose, table_camera, view_at};
 
-/// The model's silhouette at `q`, 200 grey levels on 40.
-fn painted(model: &Model, q: &[f32], camera: &Camera) -> Vec<u8> {
+/// Which pixels of `camera`'s frame the model covers at `q`, row by row.
+fn covered(model: &Model, q: &[f32], camera: &Camera) -> Vec<bool> {
     let view = view_at(model, q, camera);
     let (w, h) = (camera.width as usize, camera.height as usize);
     (0..w * h)
-        .map(|i| {
-            let p = Vector2::new((i % w) as f32, (i / w) as f32);
-            if covers(&view, camera, &p) {
-                200
-            } else {
-                40
-            }
-        })
+        .map(|i| covers(&view, camera, &Vector2::new((i % w) as f32, (i / w) as f32)))
+        .collect()
+}
+
+/// The model's silhouette at `q`, 200 grey levels on 40.
+fn painted(model: &Model, q: &[f32], camera: &Camera) -> Vec<u8> {
+    covered(model, q, camera)
+        .into_iter()
+        .map(|c| if c { 200 } else { 40 })
         .collect()
 }
 
@@ -98,11 +99,8 @@ fn nothing_is_gathered_without_a_hand_in_view_or_with_one_class_only() {
 /// The model's silhouette at `q` with its left half lit (200) and its right half in shade
 /// (90, darker than the midpoint between the covered and uncovered means), on 40.
 fn painted_with_shade(model: &Model, q: &[f32], camera: &Camera) -> Vec<u8> {
-    let (w, h) = (camera.width as usize, camera.height as usize);
-    let view = view_at(model, q, camera);
-    let covered: Vec<bool> = (0..w * h)
-        .map(|i| covers(&view, camera, &Vector2::new((i % w) as f32, (i / w) as f32)))
-        .collect();
+    let w = camera.width as usize;
+    let covered = covered(model, q, camera);
     let (sum, count) = covered
         .iter()
         .enumerate()
