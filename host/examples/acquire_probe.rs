@@ -274,61 +274,31 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
     (acquire, finder)
 }
 
-/// The tracker's edge-direction limit, when `--angle-deg` gives one (set once in `main`).
-static TRACKER_ANGLE_DEG: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
+/// The tracker's configuration for every run, set once in `main` from the arguments.
+static TRACKER: std::sync::OnceLock<TrackerConfig> = std::sync::OnceLock::new();
 
-/// The tracker's outermost-edge share, when `--outermost-share` gives one (set once in `main`).
-static TRACKER_OUTERMOST: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
-
-/// Whether the tracker searches beyond knuckles, when `--knuckle-tips` says (set once in
-/// `main`).
-static TRACKER_KNUCKLE_TIPS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-
-/// The region rows' weight, when `--fill-weight` gives it (set once in `main`).
-static TRACKER_FILL: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
-
-/// The region rows' gathering iterations, when `--fill-gather` gives them (set once in `main`).
-static TRACKER_FILL_GATHER: std::sync::OnceLock<u8> = std::sync::OnceLock::new();
-
-/// The region rows' class margin, when `--fill-margin` gives it (set once in `main`).
-static TRACKER_FILL_MARGIN: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
-
-/// The region rows' full-weight length, when `--fill-full-length` gives it (set once in `main`).
-static TRACKER_FILL_LENGTH: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
-
-/// The tracker's iterations, when `--tracker-iterations` gives them (set once in `main`).
-static TRACKER_ITERATIONS: std::sync::OnceLock<u8> = std::sync::OnceLock::new();
-
-/// The tracker's defaults, with `--angle-deg`, `--outermost-share`, `--tracker-iterations`,
+/// The tracker's defaults with `--angle-deg`, `--outermost-share`, `--tracker-iterations`,
 /// `--knuckle-tips`, `--fill-weight`, `--fill-gather`, `--fill-margin` and
-/// `--fill-full-length` if given.
-fn tracker_config() -> TrackerConfig {
+/// `--fill-full-length` where given.
+fn tracker_config_from(args: &Args) -> TrackerConfig {
     let mut config = TrackerConfig::default();
-    if let Some(degrees) = TRACKER_ANGLE_DEG.get() {
-        config.features.max_edge_angle_rad = degrees.to_radians();
+    let (features, fill) = (&mut config.features, &mut config.fill);
+    if let Some(degrees) = args.angle_deg {
+        features.max_edge_angle_rad = degrees.to_radians();
     }
-    if let Some(share) = TRACKER_OUTERMOST.get() {
-        config.features.outermost_share = *share;
-    }
-    if let Some(iterations) = TRACKER_ITERATIONS.get() {
-        config.iterations = *iterations;
-    }
-    if let Some(on) = TRACKER_KNUCKLE_TIPS.get() {
-        config.features.knuckle_tips = *on;
-    }
-    if let Some(weight) = TRACKER_FILL.get() {
-        config.fill.weight = *weight;
-    }
-    if let Some(n) = TRACKER_FILL_GATHER.get() {
-        config.fill.gather_iterations = *n;
-    }
-    if let Some(margin) = TRACKER_FILL_MARGIN.get() {
-        config.fill.class_margin = *margin;
-    }
-    if let Some(widths) = TRACKER_FILL_LENGTH.get() {
-        config.fill.full_length_widths = *widths;
-    }
+    features.outermost_share = args.outermost_share.unwrap_or(features.outermost_share);
+    features.knuckle_tips = args.knuckle_tips.unwrap_or(features.knuckle_tips);
+    config.iterations = args.tracker_iterations.unwrap_or(config.iterations);
+    fill.weight = args.fill_weight.unwrap_or(fill.weight);
+    fill.gather_iterations = args.fill_gather.unwrap_or(fill.gather_iterations);
+    fill.class_margin = args.fill_margin.unwrap_or(fill.class_margin);
+    fill.full_length_widths = args.fill_full_length.unwrap_or(fill.full_length_widths);
     config
+}
+
+/// The tracker's configuration for this run (the defaults until `main` sets it).
+fn tracker_config() -> TrackerConfig {
+    TRACKER.get().copied().unwrap_or_default()
 }
 
 /// `huber=K`, `tukey=C` or `none`; anything else is the default leaves' weight.
@@ -997,30 +967,7 @@ fn hand_free_status_run(sequence: &Sequence, args: &Args, frames: usize) -> Resu
 
 fn main() -> Result<()> {
     let args = Args::parse();
-    if let Some(degrees) = args.angle_deg {
-        let _ = TRACKER_ANGLE_DEG.set(degrees);
-    }
-    if let Some(share) = args.outermost_share {
-        let _ = TRACKER_OUTERMOST.set(share);
-    }
-    if let Some(iterations) = args.tracker_iterations {
-        let _ = TRACKER_ITERATIONS.set(iterations);
-    }
-    if let Some(on) = args.knuckle_tips {
-        let _ = TRACKER_KNUCKLE_TIPS.set(on);
-    }
-    if let Some(weight) = args.fill_weight {
-        let _ = TRACKER_FILL.set(weight);
-    }
-    if let Some(n) = args.fill_gather {
-        let _ = TRACKER_FILL_GATHER.set(n);
-    }
-    if let Some(margin) = args.fill_margin {
-        let _ = TRACKER_FILL_MARGIN.set(margin);
-    }
-    if let Some(widths) = args.fill_full_length {
-        let _ = TRACKER_FILL_LENGTH.set(widths);
-    }
+    let _ = TRACKER.set(tracker_config_from(&args));
     if let Some(dark) = args.blackout.clone() {
         return blackout_sweep(&args, &dark);
     }
