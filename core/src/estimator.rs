@@ -32,6 +32,7 @@ use crate::config::MAX_STATES;
 use crate::model::Model;
 use crate::state::{clamp_to_limit, renormalise_quaternion, StateKind};
 
+mod bounds;
 mod config;
 mod jacobian;
 mod link_rows;

@@ -256,15 +256,18 @@ impl Tracker {
         Ok(())
     }
 
-    /// [`Tracker::track`] with residuals weighted by `robust` and edges kept within
-    /// `max_edge_angle_rad` of their prediction ([`FeatureConfig::max_edge_angle_rad`]) instead
-    /// of the configured ones, which are back in place afterwards, error or not: a search
-    /// refines its leaves under its own
-    /// ([`FinderConfig::leaf_robust`](crate::acquire::FinderConfig::leaf_robust)).
+    /// [`Tracker::track`] with residuals weighted by `robust`, edges kept within
+    /// `max_edge_angle_rad` of their prediction ([`FeatureConfig::max_edge_angle_rad`]) and
+    /// steps bounded or not (`bounded_step`, [`EstimatorConfig::bounded_step`]) instead of the
+    /// configured ones, which are back in place afterwards, error or not: a search refines its
+    /// leaves under its own
+    /// ([`FinderConfig::leaf_robust`](crate::acquire::FinderConfig::leaf_robust) and the
+    /// settings beside it).
     pub fn track_under(
         &mut self,
         robust: Robust,
         max_edge_angle_rad: f32,
+        bounded_step: bool,
         frames: &[FrameView<'_>],
     ) -> Result<FrameReport, TrackerError> {
         let own = core::mem::replace(&mut self.config.estimator.robust, robust);
@@ -272,9 +275,11 @@ impl Tracker {
             &mut self.config.features.max_edge_angle_rad,
             max_edge_angle_rad,
         );
+        let own_bounded = core::mem::replace(&mut self.config.estimator.bounded_step, bounded_step);
         let report = self.track(frames);
         self.config.estimator.robust = own;
         self.config.features.max_edge_angle_rad = own_angle;
+        self.config.estimator.bounded_step = own_bounded;
         report
     }
 
@@ -651,10 +656,13 @@ impl Tracker {
             work.normal
                 .add_prior(i, prior.for_state(i), *now - *centre, self.free);
         }
-        work.normal.step(
-            self.model.n_states(),
-            self.free,
-            &config.estimator.conditioning,
-        )
+        let conditioning = &config.estimator.conditioning;
+        if config.estimator.bounded_step {
+            work.normal
+                .bounded_step(&self.model, q, self.free, conditioning)
+        } else {
+            work.normal
+                .step(self.model.n_states(), self.free, conditioning)
+        }
     }
 }

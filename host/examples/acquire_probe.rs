@@ -166,6 +166,12 @@ struct Args {
     /// default: the tracker's).
     #[arg(long)]
     fill_full_length: Option<f32>,
+    /// Whether the tracker's steps hold joints at their bounds (default: the tracker's).
+    #[arg(long)]
+    bounded_step: Option<bool>,
+    /// Whether the leaves' refinement does (default: the search's, the plain step).
+    #[arg(long)]
+    leaf_bounded_step: Option<bool>,
     /// Write every refined leaf's judgement and true error here (CSV).
     #[arg(long)]
     leaves_csv: Option<std::path::PathBuf>,
@@ -256,6 +262,7 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         leaf_max_edge_angle_rad: args
             .leaf_angle_deg
             .map_or(f.leaf_max_edge_angle_rad, f32::to_radians),
+        leaf_bounded_step: args.leaf_bounded_step.unwrap_or(f.leaf_bounded_step),
         local_library_pose: args.local_library.unwrap_or(f.local_library_pose),
         local_starts: args.local_starts.unwrap_or(f.local_starts),
         local_frames_in_view: args.local_in_view.unwrap_or(f.local_frames_in_view),
@@ -293,6 +300,8 @@ fn tracker_config_from(args: &Args) -> TrackerConfig {
     fill.gather_iterations = args.fill_gather.unwrap_or(fill.gather_iterations);
     fill.class_margin = args.fill_margin.unwrap_or(fill.class_margin);
     fill.full_length_widths = args.fill_full_length.unwrap_or(fill.full_length_widths);
+    let estimator = &mut config.estimator;
+    estimator.bounded_step = args.bounded_step.unwrap_or(estimator.bounded_step);
     config
 }
 

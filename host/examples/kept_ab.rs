@@ -2,7 +2,7 @@
 //! seed with each variant and prints the track-life distribution per group. A variant is
 //! `default` or `key=value` overrides joined by `+` (keys: `pj`, `pt`, `pq` the prior's
 //! weights, `sj`, `st`, `sq` the conditioning; `iters`, `predict`, `window`, `slices`,
-//! `palm`, `palmw`, `tipw`, `fvf`, `outer`, `knuckle` (0: no knuckle tips); `angle` the edge-direction limit in degrees (90:
+//! `palm`, `palmw`, `tipw`, `fvf`, `outer`, `knuckle` (0: no knuckle tips), `bounds` (0: the plain step); `angle` the edge-direction limit in degrees (90:
 //! off); `huber`, `tukey` the robust kernel's px; `k`, `s`, `spawn`, `smem`, `switch` the
 //! hypotheses (their count, scoring period, samples, score memory, switch margin); `csmem`,
 //! `cswitch` the confirm phase's score memory and switch margin; `watch`

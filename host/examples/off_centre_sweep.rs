@@ -5,11 +5,17 @@
 //! seeds' rigs, noise, blur and light with each joint's centre moved to 10–30 % or 70–90 % of
 //! its range (either end, drawn per joint), the swing 70–100 % of the room left, so a setting
 //! can be judged on motions whose centre it cannot know. The folder is laid out as `bench
-//! robustness --keep` lays it out (without `states.csv`), for `kept_ab`.
+//! robustness --keep` lays it out (without `states.csv`), for `kept_ab`. With `--straight S`
+//! the centres stay the sweep's and every finger flexion is instead shifted down by S of its
+//! range and clipped at 0, so the fingers lie straight, at their lower bounds, part of the
+//! time: what a flat hand does and the sweep's motions never do (`docs/robustness.md`,
+//! "Joints at their bounds").
 //!
 //! ```text
 //! cargo run --release -p digiteyes-host --example off_centre_sweep -- /tmp/off --first-seed 5421
 //! cargo run --release -p digiteyes-host --example kept_ab -- /tmp/off default knuckle=0
+//! cargo run --release -p digiteyes-host --example off_centre_sweep -- /tmp/straight \
+//!     --first-seed 7001 --seeds 40 --straight 0.3
 //! ```
 
 use std::path::PathBuf;
@@ -37,6 +43,11 @@ struct Args {
     /// Frames per seed.
     #[arg(long, default_value_t = 200)]
     frames: usize,
+    /// Instead of moving the centres: keep the sweep's own motion and shift every finger
+    /// flexion (MCP, PIP, DIP of fingers 1-4) down by this share of its range, clipped at 0,
+    /// so the fingers lie straight (at their lower bound) part of the time, as a flat hand's do.
+    #[arg(long, default_value_t = 0.0)]
+    straight: f64,
 }
 
 fn main() -> Result<()> {
@@ -45,8 +56,13 @@ fn main() -> Result<()> {
     for seed in args.first_seed..args.first_seed + args.seeds {
         let mut scenario = random_scenario(seed, seed.is_multiple_of(2));
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x0ff_c3e7);
-        scenario.amplitudes.retain(|&(s, _)| s < BASE_STATES);
+        if args.straight == 0.0 {
+            scenario.amplitudes.retain(|&(s, _)| s < BASE_STATES);
+        }
         for s in BASE_STATES..model.n_states() {
+            if args.straight > 0.0 {
+                break;
+            }
             let Some(limit) = model.limit(s) else {
                 continue;
             };
@@ -78,7 +94,11 @@ fn main() -> Result<()> {
                 break;
             }
         }
-        let generated = generated?;
+        let mut generated = generated?;
+        if args.straight > 0.0 {
+            straighten(&model, &mut generated.truth, args.straight);
+            generated.file.initial_state = generated.truth[0].clone();
+        }
         write_generated(
             &generated,
             &args.out.join(format!("seed{seed:04}")),
@@ -87,4 +107,24 @@ fn main() -> Result<()> {
         eprintln!("seed {seed} written");
     }
     Ok(())
+}
+
+/// Every finger flexion (the three joints after each finger's abduction, states 8-10, 12-14,
+/// 16-18, 20-22) moved down by `share` of its range and clipped at its lower bound.
+fn straighten(model: &Model, truth: &mut [Vec<f64>], share: f64) {
+    let flexions = (0..4).flat_map(|finger| {
+        let abduction = BASE_STATES + 4 * finger;
+        abduction + 1..abduction + 4
+    });
+    let ranges: Vec<(usize, f64, f64)> = flexions
+        .filter_map(|s| {
+            let limit = model.limit(s)?;
+            Some((s, f64::from(limit.lo), f64::from(limit.hi)))
+        })
+        .collect();
+    for q in truth {
+        for &(s, lo, hi) in &ranges {
+            q[s] = (q[s] - share * (hi - lo)).max(lo);
+        }
+    }
 }

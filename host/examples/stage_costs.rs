@@ -78,6 +78,10 @@ struct Args {
     /// the tracker's).
     #[arg(long)]
     fill_full_length: Option<f32>,
+    /// Whether each step holds the joints it would carry out of their ranges at their bounds
+    /// (default: the tracker's).
+    #[arg(long)]
+    bounded_step: Option<bool>,
     /// The thesis' plain loop: no motion model, no silhouette check (the cost before them).
     #[arg(long)]
     plain: bool,
@@ -131,6 +135,9 @@ fn main() -> Result<()> {
     }
     if let Some(on) = args.knuckle_tips {
         config.features.knuckle_tips = on;
+    }
+    if let Some(on) = args.bounded_step {
+        config.estimator.bounded_step = on;
     }
     if let Some(window) = args.window {
         config.features.window_px = window;

@@ -89,6 +89,14 @@ pub struct EstimatorConfig {
     /// Weight of a palm outline edge row relative to a link's edge row
     /// ([`add_palm_edge_rows`](super::add_palm_edge_rows)).
     pub palm_edge_weight: f32,
+    /// Solve each step with the joints it would carry out of their ranges held at their
+    /// bounds and the other states solved again for it
+    /// ([`NormalEquations::bounded_step`](super::NormalEquations::bounded_step)), instead of
+    /// clamping them after the others moved as though they had gone on. Default on: it leaves
+    /// the sweep's track life where it was (its motions keep every joint off its bounds) and
+    /// lengthens it on motions whose fingers lie straight, at their lower bounds, part of the
+    /// time (`docs/robustness.md`, "Joints at their bounds").
+    pub bounded_step: bool,
 }
 
 impl Default for EstimatorConfig {
@@ -103,6 +111,7 @@ impl Default for EstimatorConfig {
             },
             tip_weight: 1.0,
             palm_edge_weight: 1.0,
+            bounded_step: true,
         }
     }
 }

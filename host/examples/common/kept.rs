@@ -81,6 +81,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "knuckle" => c.features.knuckle_tips = f != 0.0,
             "fvf" => c.motion.full_velocity_found = f,
             "palmw" => c.estimator.palm_edge_weight = f,
+            "bounds" => c.estimator.bounded_step = f != 0.0,
             "sj" => c.estimator.conditioning.joint = f,
             "st" => c.estimator.conditioning.translation = f,
             "sq" => c.estimator.conditioning.quaternion = f,
