@@ -158,16 +158,16 @@ fn track_under_puts_the_trackers_own_settings_back_error_or_not() {
     use digiteyes_core::estimator::Robust;
     let mut t = tracker(FreeMask::all(28)).unwrap();
     let own = *t.config();
-    assert!(own.estimator.bounded_step, "bounded by default");
+    assert!(!own.estimator.bounded_step, "the plain step by default");
     let data = vec![0u8; 64 * 48];
     let frame = FrameView::packed(&data, 64, 48).unwrap();
     let report = t
-        .track_under(Robust::Tukey(9.0), 1.5, false, &[frame])
+        .track_under(Robust::Tukey(9.0), 1.5, true, &[frame])
         .unwrap();
     assert!(report.lost);
     assert_eq!(*t.config(), own);
     let small = vec![0u8; 32 * 48];
     let wrong = FrameView::packed(&small, 32, 48).unwrap();
-    assert!(t.track_under(Robust::None, 0.1, false, &[wrong]).is_err());
+    assert!(t.track_under(Robust::None, 0.1, true, &[wrong]).is_err());
     assert_eq!(*t.config(), own);
 }

@@ -55,10 +55,10 @@ pub struct FinderConfig {
     pub leaf_max_edge_angle_rad: f32,
     /// Whether a leaf's refinement bounds its steps at the joints' ranges, in place of the
     /// tracker's own [`EstimatorConfig::bounded_step`](crate::estimator::EstimatorConfig::bounded_step)
-    /// (default false: the plain step). The acceptance's bars were set from the scores of
-    /// leaves refined by the plain step, and the bounded step fits a leaf to clutter better:
-    /// on 2,000 hand-free frames of one mono rig its best leaf scored 0.936, over the
-    /// one-camera bar of 0.93, against 0.915 (`docs/recovery.md`).
+    /// (default false: the plain step, whatever the tracker's). The acceptance's bars were set
+    /// from the scores of leaves refined by the plain step, and the bounded step fits a leaf
+    /// to clutter better: on 2,000 hand-free frames of one mono rig its best leaf scored
+    /// 0.936, over the one-camera bar of 0.93, against 0.915 (`docs/recovery.md`).
     pub leaf_bounded_step: bool,
     /// The local re-acquisition after a loss also starts from the last good palm with the
     /// library's finger pose that scores best on the frame: the hand's fingers move on while
