@@ -27,6 +27,8 @@ use std::ops::RangeInclusive;
 
 #[path = "common/kept.rs"]
 mod kept;
+#[path = "common/overrides.rs"]
+mod overrides;
 
 use anyhow::{anyhow, Result};
 use clap::Parser;
@@ -142,33 +144,15 @@ struct Args {
     /// The tracker's own edge-direction limit (degrees; 90: off; default: the tracker's).
     #[arg(long)]
     angle_deg: Option<f32>,
-    /// The tracker's outermost-edge share (0: the strongest edge; default: the tracker's).
-    #[arg(long)]
-    outermost_share: Option<f32>,
-    /// Whether the tracker searches beyond knuckles where the outline ends (default: the
-    /// tracker's).
-    #[arg(long)]
-    knuckle_tips: Option<bool>,
     /// The tracker's Gauss–Newton iterations per frame (default: the tracker's).
     #[arg(long)]
     tracker_iterations: Option<u8>,
-    /// The weight of the tracker's region rows (0: none; default: the tracker's).
-    #[arg(long)]
-    fill_weight: Option<f32>,
     /// The tracker's region rows gathered afresh on this many of a frame's first iterations
     /// (default: the tracker's).
     #[arg(long)]
     fill_gather: Option<u8>,
-    /// The region rows' class margin (share of the contrast; default: the tracker's).
-    #[arg(long)]
-    fill_margin: Option<f32>,
-    /// The region rows' full-weight length in widths (0: every link at full weight;
-    /// default: the tracker's).
-    #[arg(long)]
-    fill_full_length: Option<f32>,
-    /// Whether the tracker's steps hold joints at their bounds (default: the tracker's).
-    #[arg(long)]
-    bounded_step: Option<bool>,
+    #[command(flatten)]
+    tracker: overrides::TrackerOverrides,
     /// Whether the leaves' refinement does (default: the search's, the plain step).
     #[arg(long)]
     leaf_bounded_step: Option<bool>,
@@ -284,24 +268,17 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
 /// The tracker's configuration for every run, set once in `main` from the arguments.
 static TRACKER: std::sync::OnceLock<TrackerConfig> = std::sync::OnceLock::new();
 
-/// The tracker's defaults with `--angle-deg`, `--outermost-share`, `--tracker-iterations`,
-/// `--knuckle-tips`, `--fill-weight`, `--fill-gather`, `--fill-margin` and
-/// `--fill-full-length` where given.
+/// The tracker's defaults with `--angle-deg`, `--tracker-iterations`, `--fill-gather` and the
+/// shared overrides (`common/overrides.rs`) where given.
 fn tracker_config_from(args: &Args) -> TrackerConfig {
     let mut config = TrackerConfig::default();
-    let (features, fill) = (&mut config.features, &mut config.fill);
     if let Some(degrees) = args.angle_deg {
-        features.max_edge_angle_rad = degrees.to_radians();
+        config.features.max_edge_angle_rad = degrees.to_radians();
     }
-    features.outermost_share = args.outermost_share.unwrap_or(features.outermost_share);
-    features.knuckle_tips = args.knuckle_tips.unwrap_or(features.knuckle_tips);
     config.iterations = args.tracker_iterations.unwrap_or(config.iterations);
-    fill.weight = args.fill_weight.unwrap_or(fill.weight);
+    let fill = &mut config.fill;
     fill.gather_iterations = args.fill_gather.unwrap_or(fill.gather_iterations);
-    fill.class_margin = args.fill_margin.unwrap_or(fill.class_margin);
-    fill.full_length_widths = args.fill_full_length.unwrap_or(fill.full_length_widths);
-    let estimator = &mut config.estimator;
-    estimator.bounded_step = args.bounded_step.unwrap_or(estimator.bounded_step);
+    args.tracker.apply(&mut config);
     config
 }
 

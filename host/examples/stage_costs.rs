@@ -18,6 +18,8 @@
 //! joint-angle and translation errors against `truth.csv` show what a configuration costs in
 //! accuracy. Prints one line of `key=value` pairs for the script to read.
 
+#[path = "common/overrides.rs"]
+mod overrides;
 #[path = "../benches/support/mod.rs"]
 mod support;
 
@@ -60,28 +62,8 @@ struct Args {
     /// tracker's), to cost the test.
     #[arg(long)]
     edge_angle_deg: Option<f32>,
-    /// The slice search's outermost-edge share (0: the strongest edge; default: the
-    /// tracker's), to cost the choice.
-    #[arg(long)]
-    outermost_share: Option<f32>,
-    /// Whether the tip search also runs beyond knuckles where the outline ends (default: the
-    /// tracker's), to cost it.
-    #[arg(long)]
-    knuckle_tips: Option<bool>,
-    /// The weight of the region rows (0: none; default: the tracker's).
-    #[arg(long)]
-    fill_weight: Option<f32>,
-    /// The region rows' class margin (share of the contrast; default: the tracker's).
-    #[arg(long)]
-    fill_margin: Option<f32>,
-    /// The region rows' full-weight length in widths (0: every link at full weight; default:
-    /// the tracker's).
-    #[arg(long)]
-    fill_full_length: Option<f32>,
-    /// Whether each step holds the joints it would carry out of their ranges at their bounds
-    /// (default: the tracker's).
-    #[arg(long)]
-    bounded_step: Option<bool>,
+    #[command(flatten)]
+    tracker: overrides::TrackerOverrides,
     /// The thesis' plain loop: no motion model, no silhouette check (the cost before them).
     #[arg(long)]
     plain: bool,
@@ -121,24 +103,7 @@ fn main() -> Result<()> {
     if let Some(degrees) = args.edge_angle_deg {
         config.features.max_edge_angle_rad = degrees.to_radians();
     }
-    if let Some(share) = args.outermost_share {
-        config.features.outermost_share = share;
-    }
-    if let Some(weight) = args.fill_weight {
-        config.fill.weight = weight;
-    }
-    if let Some(margin) = args.fill_margin {
-        config.fill.class_margin = margin;
-    }
-    if let Some(widths) = args.fill_full_length {
-        config.fill.full_length_widths = widths;
-    }
-    if let Some(on) = args.knuckle_tips {
-        config.features.knuckle_tips = on;
-    }
-    if let Some(on) = args.bounded_step {
-        config.estimator.bounded_step = on;
-    }
+    args.tracker.apply(&mut config);
     if let Some(window) = args.window {
         config.features.window_px = window;
     }
