@@ -20,15 +20,14 @@
 
 use std::path::PathBuf;
 
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use clap::Parser;
-use digiteyes_core::model::{Model, BASE_STATES};
-use digiteyes_host::scenarios::random::{random_scenario, zoomed};
-use digiteyes_host::scenarios::{
-    generate_from, write_generated, RenderOptions, MAX_ZOOM_OUTS, ZOOM_OUT,
-};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+use digiteyes_host::scenarios::RenderOptions;
+
+#[path = "common/motions.rs"]
+mod motions;
+
+use motions::{render_seed, Motion};
 
 #[derive(Parser)]
 struct Args {
@@ -52,33 +51,12 @@ struct Args {
 
 fn main() -> Result<()> {
     let args = Args::parse();
-    let model = Model::hand().map_err(|e| anyhow!("built-in hand model: {e}"))?;
+    let motion = if args.straight > 0.0 {
+        Motion::Straight(args.straight)
+    } else {
+        Motion::OffCentre
+    };
     for seed in args.first_seed..args.first_seed + args.seeds {
-        let mut scenario = random_scenario(seed, seed.is_multiple_of(2));
-        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x0ff_c3e7);
-        if args.straight == 0.0 {
-            scenario.amplitudes.retain(|&(s, _)| s < BASE_STATES);
-        }
-        for s in BASE_STATES..model.n_states() {
-            if args.straight > 0.0 {
-                break;
-            }
-            let Some(limit) = model.limit(s) else {
-                continue;
-            };
-            let (lo, hi) = (f64::from(limit.lo), f64::from(limit.hi));
-            let share = if rng.random_bool(0.5) {
-                rng.random_range(0.1..0.3)
-            } else {
-                rng.random_range(0.7..0.9)
-            };
-            let centre = lo + (hi - lo) * share;
-            scenario.base[s] = centre;
-            let room = (centre - lo).min(hi - centre);
-            scenario
-                .amplitudes
-                .push((s, room * rng.random_range(0.7..1.0)));
-        }
         let options = RenderOptions {
             seed,
             frames: Some(args.frames),
@@ -86,45 +64,9 @@ fn main() -> Result<()> {
             supersample: 2,
             ..RenderOptions::default()
         };
-        // As `render` does: zoomed out step by step until the whole motion stays in view.
-        let mut generated = Err(anyhow!("seed {seed}: no view fits"));
-        for k in 0..=MAX_ZOOM_OUTS {
-            generated = generate_from(zoomed(&scenario, ZOOM_OUT.powi(k as i32)), &options);
-            if generated.is_ok() {
-                break;
-            }
-        }
-        let mut generated = generated?;
-        if args.straight > 0.0 {
-            straighten(&model, &mut generated.truth, args.straight);
-            generated.file.initial_state = generated.truth[0].clone();
-        }
-        write_generated(
-            &generated,
-            &args.out.join(format!("seed{seed:04}")),
-            &options,
-        )?;
+        let out = args.out.join(format!("seed{seed:04}"));
+        render_seed(seed, seed.is_multiple_of(2), motion, &options, &out)?;
         eprintln!("seed {seed} written");
     }
     Ok(())
-}
-
-/// Every finger flexion (the three joints after each finger's abduction, states 8-10, 12-14,
-/// 16-18, 20-22) moved down by `share` of its range and clipped at its lower bound.
-fn straighten(model: &Model, truth: &mut [Vec<f64>], share: f64) {
-    let flexions = (0..4).flat_map(|finger| {
-        let abduction = BASE_STATES + 4 * finger;
-        abduction + 1..abduction + 4
-    });
-    let ranges: Vec<(usize, f64, f64)> = flexions
-        .filter_map(|s| {
-            let limit = model.limit(s)?;
-            Some((s, f64::from(limit.lo), f64::from(limit.hi)))
-        })
-        .collect();
-    for q in truth {
-        for &(s, lo, hi) in &ranges {
-            q[s] = (q[s] - share * (hi - lo)).max(lo);
-        }
-    }
 }
