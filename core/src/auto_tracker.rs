@@ -789,13 +789,14 @@ impl AutoTracker {
     ) -> Result<Refined, AutoError> {
         let mut q = start;
         let mut report = FrameReport::default();
-        let leaf_robust = self.finder.config().leaf_robust;
-        let leaf_angle = self.finder.config().leaf_max_edge_angle_rad;
-        let leaf_bounded = self.finder.config().leaf_bounded_step;
+        let overrides = self
+            .finder
+            .config()
+            .local_overrides(self.multi.tracker().config());
         let tracker = self.multi.tracker_mut();
         for _ in 0..LOCAL_REFINE_PASSES {
             tracker.restart_fresh(&q[..n])?;
-            report = tracker.track_under(leaf_robust, leaf_angle, leaf_bounded, frames)?;
+            report = tracker.track_under(&overrides, frames)?;
             q[..n].copy_from_slice(&tracker.state()[..n]);
             if report.lost {
                 return Ok(Refined {

@@ -22,10 +22,26 @@ use crate::frame::{FrameError, FrameView};
 use crate::kinematics::{KinematicsError, Poses};
 use crate::measurer::{LocalFrames, Measurer};
 use crate::model::Model;
-use crate::motion::{velocity_trust, MotionConfig};
+use crate::motion::{velocity_trust, MotionConfig, PriorWeights};
 use crate::palm_outline::PalmOutline;
 use crate::projection::ProjectedModel;
 use crate::state::{clamp_to_limit, renormalise_quaternion, TRANSLATION};
+
+/// What a search's refinement runs the tracker under for one frame, in place of its
+/// configured settings ([`Tracker::track_under`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RefineOverrides {
+    /// The robust weight of edge and tip residuals.
+    pub robust: Robust,
+    /// The edge-direction test (rad; π/2 or more: off).
+    pub max_edge_angle_rad: f32,
+    /// Whether each step holds the joints it would carry out of their ranges at their bounds.
+    pub bounded_step: bool,
+    /// The prior toward the predicted state: after [`Tracker::restart_fresh`], toward the
+    /// start itself.
+    pub prior: PriorWeights,
+}
 
 /// The cameras, if there are 1 to [`MAX_CAMERAS`] and each is usable.
 fn checked_cameras(cameras: &[Camera]) -> Result<Vec<Camera, MAX_CAMERAS>, TrackerError> {
@@ -256,30 +272,21 @@ impl Tracker {
         Ok(())
     }
 
-    /// [`Tracker::track`] with residuals weighted by `robust`, edges kept within
-    /// `max_edge_angle_rad` of their prediction ([`FeatureConfig::max_edge_angle_rad`]) and
-    /// steps bounded or not (`bounded_step`, [`EstimatorConfig::bounded_step`]) instead of the
-    /// configured ones, which are back in place afterwards, error or not: a search refines its
-    /// leaves under its own
-    /// ([`FinderConfig::leaf_robust`](crate::acquire::FinderConfig::leaf_robust) and the
-    /// settings beside it).
+    /// [`Tracker::track`] under `overrides` instead of the configured robust weight, edge
+    /// test, step and prior, which are back in place afterwards, error or not: a search
+    /// refines its leaves under its own ([`FinderConfig::leaf_overrides`](crate::acquire::FinderConfig::leaf_overrides)).
     pub fn track_under(
         &mut self,
-        robust: Robust,
-        max_edge_angle_rad: f32,
-        bounded_step: bool,
+        overrides: &RefineOverrides,
         frames: &[FrameView<'_>],
     ) -> Result<FrameReport, TrackerError> {
-        let own = core::mem::replace(&mut self.config.estimator.robust, robust);
-        let own_angle = core::mem::replace(
-            &mut self.config.features.max_edge_angle_rad,
-            max_edge_angle_rad,
-        );
-        let own_bounded = core::mem::replace(&mut self.config.estimator.bounded_step, bounded_step);
+        let own = self.config;
+        self.config.estimator.robust = overrides.robust;
+        self.config.features.max_edge_angle_rad = overrides.max_edge_angle_rad;
+        self.config.estimator.bounded_step = overrides.bounded_step;
+        self.config.motion.prior = overrides.prior;
         let report = self.track(frames);
-        self.config.estimator.robust = own;
-        self.config.features.max_edge_angle_rad = own_angle;
-        self.config.estimator.bounded_step = own_bounded;
+        self.config = own;
         report
     }
 

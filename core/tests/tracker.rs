@@ -156,18 +156,33 @@ fn reset_rejects_a_nan_state_and_keeps_the_old_one() {
 #[test]
 fn track_under_puts_the_trackers_own_settings_back_error_or_not() {
     use digiteyes_core::estimator::Robust;
+    use digiteyes_core::motion::PriorWeights;
+    use digiteyes_core::tracker::RefineOverrides;
     let mut t = tracker(FreeMask::all(28)).unwrap();
     let own = *t.config();
     assert!(!own.estimator.bounded_step, "the plain step by default");
     let data = vec![0u8; 64 * 48];
     let frame = FrameView::packed(&data, 64, 48).unwrap();
-    let report = t
-        .track_under(Robust::Tukey(9.0), 1.5, true, &[frame])
-        .unwrap();
+    let overrides = RefineOverrides {
+        robust: Robust::Tukey(9.0),
+        max_edge_angle_rad: 1.5,
+        bounded_step: true,
+        prior: PriorWeights::OFF,
+    };
+    assert_ne!(
+        overrides.prior, own.motion.prior,
+        "the prior is overridden too"
+    );
+    let report = t.track_under(&overrides, &[frame]).unwrap();
     assert!(report.lost);
     assert_eq!(*t.config(), own);
     let small = vec![0u8; 32 * 48];
     let wrong = FrameView::packed(&small, 32, 48).unwrap();
-    assert!(t.track_under(Robust::None, 0.1, true, &[wrong]).is_err());
+    let overrides = RefineOverrides {
+        robust: Robust::None,
+        max_edge_angle_rad: 0.1,
+        ..overrides
+    };
+    assert!(t.track_under(&overrides, &[wrong]).is_err());
     assert_eq!(*t.config(), own);
 }

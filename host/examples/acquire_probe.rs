@@ -27,6 +27,9 @@ use std::ops::RangeInclusive;
 
 #[path = "common/kept.rs"]
 mod kept;
+#[path = "common/motions.rs"]
+mod motions;
+use motions::render_seed;
 #[path = "common/overrides.rs"]
 mod overrides;
 
@@ -45,7 +48,7 @@ use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig, StateScorer};
 use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::render::hand_free::{hand_free, hand_free_frame, KINDS};
-use digiteyes_host::scenarios::{render_scenario, RenderOptions};
+use digiteyes_host::scenarios::RenderOptions;
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::TrackerConfig;
 
@@ -156,6 +159,13 @@ struct Args {
     /// Whether the leaves' refinement does (default: the search's, the plain step).
     #[arg(long)]
     leaf_bounded_step: Option<bool>,
+    /// The share of the tracker's prior toward the predicted state the leaves' refinement
+    /// keeps (1: the tracker's own; 0: none; default: the search's, by the rig's cameras).
+    #[arg(long)]
+    leaf_prior_share: Option<f32>,
+    /// The same for the local re-acquisition's starts (default: the search's).
+    #[arg(long)]
+    local_prior_share: Option<f32>,
     /// Write every refined leaf's judgement and true error here (CSV).
     #[arg(long)]
     leaves_csv: Option<std::path::PathBuf>,
@@ -185,11 +195,16 @@ struct Args {
     #[arg(long, default_value_t = 10.0)]
     limit_px: f32,
     /// Print the best hypothesis' score and tip error on frames with several hypotheses; on
-    /// every claimed frame the claim against the truth (both scored, the palm's offset and
-    /// turn, the turn from the truth's depth-flipped reading, each finger's joint RMS); and
-    /// the truth's own score every 10th frame.
+    /// every claimed frame, and for every refined leaf, the claim against the truth (both
+    /// scored, the palm's offset and turn, the turn from the truth's depth-flipped reading,
+    /// each finger's joint RMS); and the truth's own score every 10th frame.
     #[arg(long)]
     trace: bool,
+    /// The fingers' motion: `sweep` (the sweep's own), `off-centre` (each joint swinging near
+    /// either end of its range) or `straight=S` (the sweep's, flexions shifted down by S of
+    /// their range and clipped at 0); the rigs, noise, blur and light are each seed's own.
+    #[arg(long, default_value = "sweep")]
+    motion: motions::Motion,
     /// The blackout sweep instead: render frames A..B without the hand, track from the
     /// initial state, and report whether each seed is re-acquired within `--within` frames
     /// of the hand's return (use with `--frames 200`).
@@ -247,6 +262,8 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             .leaf_angle_deg
             .map_or(f.leaf_max_edge_angle_rad, f32::to_radians),
         leaf_bounded_step: args.leaf_bounded_step.unwrap_or(f.leaf_bounded_step),
+        leaf_prior_share: args.leaf_prior_share.map_or(f.leaf_prior_share, |v| [v, v]),
+        local_prior_share: args.local_prior_share.unwrap_or(f.local_prior_share),
         local_library_pose: args.local_library.unwrap_or(f.local_library_pose),
         local_starts: args.local_starts.unwrap_or(f.local_starts),
         local_frames_in_view: args.local_in_view.unwrap_or(f.local_frames_in_view),
@@ -593,6 +610,21 @@ fn run(
             if report.leaf_score.is_some() {
                 out.refined += 1;
             }
+            if let (true, true, Some((verdict, q))) = (
+                args.trace,
+                report.leaf_score.is_some(),
+                auto.finder().last_leaf(),
+            ) {
+                let n = sequence.n_states();
+                let images = kept::read_instant(sequence, k)?;
+                let views = kept::views(&images)?;
+                let e = tip_error_px(&sequence.model, &sequence.cameras, &q[..n], &truth_k);
+                eprintln!(
+                    "leaf {label} {k} accepted {} tip {e:.1} px {}",
+                    u8::from(verdict.accepted),
+                    claim_against_truth(sequence, &views, &q[..n], &truth_k, &acquire)?
+                );
+            }
             if let (Some((verdict, q)), Some(f)) = (auto.finder().last_leaf(), csv.as_mut()) {
                 let n = sequence.n_states();
                 let e = tip_error_px(&sequence.model, &sequence.cameras, &q[..n], &truth_k);
@@ -764,7 +796,7 @@ fn blackout_sweep(args: &Args, dark: &std::ops::Range<usize>) -> Result<()> {
                 blackout: Some(dark.clone()),
                 ..RenderOptions::default()
             };
-            render_scenario(&format!("random-{rig}"), &seq, &options)?;
+            render_seed(seed, rig == "stereo", args.motion, &options, &seq)?;
             let sequence = Sequence::open(&seq)?;
             let r = blackout_run(&sequence, args, dark, &format!("{rig}-{seed}"))?;
             println!(
@@ -973,7 +1005,6 @@ fn main() -> Result<()> {
         args.rigs.iter().map(|r| (r.clone(), Vec::new())).collect();
     for seed in args.seeds.clone() {
         for (rig, runs) in summary.iter_mut() {
-            let name = format!("random-{rig}");
             let seq = dir.path().join(format!("{rig}{seed}"));
             let options = RenderOptions {
                 seed,
@@ -981,7 +1012,7 @@ fn main() -> Result<()> {
                 size: Some((w, h)),
                 ..RenderOptions::default()
             };
-            render_scenario(&name, &seq, &options)?;
+            render_seed(seed, rig == "stereo", args.motion, &options, &seq)?;
             let sequence = Sequence::open(&seq)?;
             let r = run(&sequence, &args, &format!("{rig}-{seed}"), &mut csv)?;
             if args.oracle {

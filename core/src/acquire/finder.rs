@@ -11,7 +11,8 @@ use crate::config::{MAX_CAMERAS, MAX_STATES};
 use crate::estimator::Robust;
 use crate::frame::FrameView;
 use crate::likelihood::EdgeMap;
-use crate::tracker::{FrameReport, Tracker, TrackerError};
+use crate::motion::PriorWeights;
+use crate::tracker::{FrameReport, RefineOverrides, Tracker, TrackerConfig, TrackerError};
 
 use super::accept::{AcceptConfig, Verdict};
 use super::{Acquirer, Progress, MAX_KEEP};
@@ -60,6 +61,18 @@ pub struct FinderConfig {
     /// to clutter better: on 2,000 hand-free frames of one mono rig its best leaf scored
     /// 0.936, over the one-camera bar of 0.93, against 0.915 (`docs/recovery.md`).
     pub leaf_bounded_step: bool,
+    /// The share of the tracker's prior toward the predicted state that a leaf's refinement
+    /// keeps, with two or more cameras (`[0]`) and with one (`[1]`); default 1, the
+    /// tracker's own. A leaf is restarted fresh, so its prior pulls toward the leaf itself:
+    /// toward the library's finger pose the search guessed, not toward a motion the hand
+    /// made. Measured and left at 1 (`docs/recovery.md`, "The leaves' prior"): without it
+    /// stereo acquires a few more hands whose fingers are far from the library's poses but
+    /// claims 13 % more wrong frames, and one camera fits leaves to clutter over the
+    /// acceptance's bar.
+    pub leaf_prior_share: [f32; 2],
+    /// The same for the local re-acquisition's starts (1: the tracker's own), which are made
+    /// from the last good state of a track, not guessed.
+    pub local_prior_share: f32,
     /// The local re-acquisition after a loss also starts from the last good palm with the
     /// library's finger pose that scores best on the frame: the hand's fingers move on while
     /// it is hidden, and Gauss–Newton from the old ones can settle on a wrong pose.
@@ -100,6 +113,41 @@ pub struct FinderConfig {
     pub confirm_score_memory: f32,
 }
 
+impl FinderConfig {
+    /// What a leaf's refinement runs the tracker under, from the tracker's own `config` and
+    /// cameras: this search's robust weight, edge test and step, and
+    /// [`FinderConfig::leaf_prior_share`] of its prior.
+    pub fn leaf_overrides(&self, config: &TrackerConfig, n_cameras: usize) -> RefineOverrides {
+        let share = self.leaf_prior_share[usize::from(n_cameras < 2)];
+        self.overrides(config, share)
+    }
+
+    /// What a local re-acquisition's start's refinement runs the tracker under: as a leaf's,
+    /// with [`FinderConfig::local_prior_share`] of the tracker's prior.
+    pub fn local_overrides(&self, config: &TrackerConfig) -> RefineOverrides {
+        self.overrides(config, self.local_prior_share)
+    }
+
+    fn overrides(&self, config: &TrackerConfig, prior_share: f32) -> RefineOverrides {
+        let own = config.motion.prior;
+        let share = if prior_share.is_finite() {
+            prior_share.clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        RefineOverrides {
+            robust: self.leaf_robust,
+            max_edge_angle_rad: self.leaf_max_edge_angle_rad,
+            bounded_step: self.leaf_bounded_step,
+            prior: PriorWeights {
+                quaternion: own.quaternion * share,
+                translation: own.translation * share,
+                joint: own.joint * share,
+            },
+        }
+    }
+}
+
 impl Default for FinderConfig {
     fn default() -> Self {
         FinderConfig {
@@ -115,6 +163,8 @@ impl Default for FinderConfig {
             leaf_robust: Robust::Huber(2.0),
             leaf_max_edge_angle_rad: core::f32::consts::FRAC_PI_2,
             leaf_bounded_step: false,
+            leaf_prior_share: [1.0, 1.0],
+            local_prior_share: 1.0,
             local_library_pose: true,
             local_starts: 3,
             local_frames_in_view: 8,
@@ -326,10 +376,11 @@ impl Finder {
         leaf: &[f32; MAX_STATES],
         n: usize,
     ) -> Result<(Verdict, [f32; MAX_STATES], FrameReport), TrackerError> {
-        let (robust, angle) = (self.config.leaf_robust, self.config.leaf_max_edge_angle_rad);
-        let bounded = self.config.leaf_bounded_step;
+        let overrides = self
+            .config
+            .leaf_overrides(tracker.config(), tracker.cameras().len());
         tracker.restart_fresh(&leaf[..n])?;
-        let mut report = tracker.track_under(robust, angle, bounded, frames)?;
+        let mut report = tracker.track_under(&overrides, frames)?;
         for _ in 1..self.config.passes_per_leaf.max(1) {
             if report.lost {
                 break;
@@ -340,7 +391,7 @@ impl Finder {
                 *d = *s;
             }
             tracker.restart_fresh(&q[..n])?;
-            report = tracker.track_under(robust, angle, bounded, frames)?;
+            report = tracker.track_under(&overrides, frames)?;
         }
         let mut q = [0.0f32; MAX_STATES];
         for (d, s) in q.iter_mut().zip(tracker.state()) {
