@@ -135,16 +135,19 @@ impl Poses {
             r: quaternion::rotation(u[0], u[1], u[2], u[3]),
             t: Vector3::new(q[4], q[5], q[6]),
         };
-        for (k, e) in self.quat_derivative.iter_mut().enumerate() {
-            let mut d = Matrix3::zeros();
-            for axis in 0..3 {
-                let mut v = Vector3::zeros();
-                v[axis] = 1.0;
-                if let Some(cols) = quaternion::rotation_derivatives(raw, &v) {
-                    d.set_column(axis, &cols[k]);
+        // D_k's column `axis` is ∂(R e_axis)/∂q_k: one call per axis gives all four k.
+        let mut d = [Matrix3::zeros(); 4];
+        for axis in 0..3 {
+            let mut v = Vector3::zeros();
+            v[axis] = 1.0;
+            if let Some(cols) = quaternion::rotation_derivatives(raw, &v) {
+                for (dk, col) in d.iter_mut().zip(&cols) {
+                    dk.set_column(axis, col);
                 }
             }
-            *e = d * palm.r.transpose();
+        }
+        for (e, dk) in self.quat_derivative.iter_mut().zip(&d) {
+            *e = dk * palm.r.transpose();
         }
         let links = model.links();
         self.n_frames = links.len();

@@ -186,3 +186,37 @@ fn track_under_puts_the_trackers_own_settings_back_error_or_not() {
     assert!(t.track_under(&overrides, &[wrong]).is_err());
     assert_eq!(*t.config(), own);
 }
+
+#[test]
+fn a_leafs_refinement_keeps_the_share_of_the_prior_its_rig_is_given() {
+    use digiteyes_core::acquire::FinderConfig;
+    use digiteyes_core::motion::PriorWeights;
+    let own = TrackerConfig::default();
+    assert!(own.motion.prior.joint > 0.0 && own.motion.prior.translation > 0.0);
+    let finder = FinderConfig {
+        leaf_prior_share: [0.25, 1.0],
+        local_prior_share: 0.0,
+        ..FinderConfig::default()
+    };
+    assert_eq!(finder.leaf_overrides(&own, 1).prior, own.motion.prior);
+    let stereo = finder.leaf_overrides(&own, 2);
+    assert_eq!(stereo.prior.joint, own.motion.prior.joint * 0.25);
+    assert_eq!(stereo.prior.translation, own.motion.prior.translation * 0.25);
+    assert_eq!(stereo.robust, finder.leaf_robust);
+    assert_eq!(stereo.max_edge_angle_rad, finder.leaf_max_edge_angle_rad);
+    assert_eq!(stereo.bounded_step, finder.leaf_bounded_step);
+    assert_eq!(finder.local_overrides(&own).prior, PriorWeights::OFF);
+    // A share that is not one: not a number keeps the tracker's own, beyond 1 is 1.
+    let odd = FinderConfig {
+        leaf_prior_share: [f32::NAN, 3.0],
+        ..FinderConfig::default()
+    };
+    assert_eq!(odd.leaf_overrides(&own, 2).prior, own.motion.prior);
+    assert_eq!(odd.leaf_overrides(&own, 1).prior, own.motion.prior);
+    // The defaults: the tracker's own prior in every rig.
+    let default = FinderConfig::default();
+    for n in 1..=2 {
+        assert_eq!(default.leaf_overrides(&own, n).prior, own.motion.prior);
+    }
+    assert_eq!(default.local_overrides(&own).prior, own.motion.prior);
+}

@@ -136,7 +136,7 @@ pub(crate) fn place(
                     let z = c0.to_camera(&moved).z;
                     if z.is_finite() && z >= z_near && z <= z_far {
                         set_palm(q, &moved);
-                        return scratch.pose(model, &q[..n_states.min(MAX_STATES)]);
+                        return palm_is_finite(q);
                     }
                 }
             }
@@ -155,7 +155,13 @@ pub(crate) fn place(
     let predicted = goal0 + (at0 - goal0) * (z0 / z1);
     let uv = goal0 + (goal0 - predicted);
     set_palm(q, &back_project(c0, &uv, z1));
-    scratch.pose(model, &q[..n_states.min(MAX_STATES)])
+    palm_is_finite(q)
+}
+
+/// Whether the palm's position is finite: all a placement changes of a state that was posed,
+/// so the placed state poses too (the scorer poses it again when it scores it).
+fn palm_is_finite(q: &[f32; MAX_STATES]) -> bool {
+    q[TRANSLATION].iter().all(|v| v.is_finite())
 }
 
 fn set_palm(q: &mut [f32; MAX_STATES], p: &Vector3<f32>) {
