@@ -201,7 +201,10 @@ fn a_leafs_refinement_keeps_the_share_of_the_prior_its_rig_is_given() {
     assert_eq!(finder.leaf_overrides(&own, 1).prior, own.motion.prior);
     let stereo = finder.leaf_overrides(&own, 2);
     assert_eq!(stereo.prior.joint, own.motion.prior.joint * 0.25);
-    assert_eq!(stereo.prior.translation, own.motion.prior.translation * 0.25);
+    assert_eq!(
+        stereo.prior.translation,
+        own.motion.prior.translation * 0.25
+    );
     assert_eq!(stereo.robust, finder.leaf_robust);
     assert_eq!(stereo.max_edge_angle_rad, finder.leaf_max_edge_angle_rad);
     assert_eq!(stereo.bounded_step, finder.leaf_bounded_step);
