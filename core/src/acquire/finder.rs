@@ -65,7 +65,7 @@ pub struct FinderConfig {
     /// keeps, with two or more cameras (`[0]`) and with one (`[1]`); default 1, the
     /// tracker's own. A leaf is restarted fresh, so its prior pulls toward the leaf itself:
     /// toward the library's finger pose the search guessed, not toward a motion the hand
-    /// made. Measured and left at 1 (`docs/recovery.md`, "The leaves' prior"): without it
+    /// made. Measured and left at 1 (`docs/recovery.md`, "Motions off mid-range"): without it
     /// stereo acquires a few more hands whose fingers are far from the library's poses but
     /// claims 13 % more wrong frames, and one camera fits leaves to clutter over the
     /// acceptance's bar.
