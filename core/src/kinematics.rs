@@ -51,8 +51,12 @@ impl Pose {
 
     /// The DH transform `Rot_z(theta) · Trans_z(d) · Trans_x(a) · Rot_x(alpha)`.
     pub fn dh(theta: f32, d: f32, a: f32, alpha: f32) -> Pose {
+        Pose::dh_twisted(theta, d, a, libm::sincosf(alpha))
+    }
+
+    /// [`Pose::dh`] with the twist given by its sine and cosine.
+    pub fn dh_twisted(theta: f32, d: f32, a: f32, (sa, ca): (f32, f32)) -> Pose {
         let (s, c) = libm::sincosf(theta);
-        let (sa, ca) = libm::sincosf(alpha);
         Pose {
             r: Matrix3::new(c, -s * ca, s * sa, s, c * ca, -c * sa, 0.0, sa, ca),
             t: Vector3::new(a * c, a * s, d),
@@ -236,5 +240,5 @@ pub fn row_transform(link: &crate::model::Link, q: &[f32]) -> Pose {
         Theta::Const(v) => v,
         Theta::State(s) => q.get(usize::from(s)).copied().unwrap_or(0.0),
     };
-    Pose::dh(theta, link.d, link.a, link.alpha)
+    Pose::dh_twisted(theta, link.d, link.a, link.alpha_sin_cos())
 }

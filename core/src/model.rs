@@ -90,6 +90,15 @@ pub struct Link {
     pub children: Vec<u8, MAX_CHILDREN>,
     /// 1-based line of the row in the source text.
     pub line: u32,
+    /// `sin(alpha)` and `cos(alpha)`, computed once when the row is read.
+    alpha_sin_cos: (f32, f32),
+}
+
+impl Link {
+    /// `sin(alpha)` and `cos(alpha)` (libm's `sincosf`, computed when the model was read).
+    pub fn alpha_sin_cos(&self) -> (f32, f32) {
+        self.alpha_sin_cos
+    }
 }
 
 /// A joint range (rad).
@@ -503,6 +512,7 @@ fn parse_row<'a>(
             parent: None,
             children: Vec::new(),
             line,
+            alpha_sin_cos: libm::sincosf(alpha),
         },
         children,
     })

@@ -24,7 +24,10 @@ use nalgebra::Vector2;
 
 use crate::camera::Camera;
 use crate::frame::FrameView;
-use crate::projection::{Bounds, ProjectedModel};
+use heapless::Vec;
+
+use crate::config::MAX_LINKS;
+use crate::projection::{Bounds, ProjectedModel, ProjectedPalm};
 
 /// Samples along each side of the grid, at most.
 pub const MAX_GRID: usize = 48;
@@ -35,9 +38,6 @@ pub const MARGIN: f32 = 0.25;
 
 /// The fewest samples of each class for a score to mean anything.
 pub const MIN_CLASS_SAMPLES: u32 = 8;
-
-/// A grid point outside the frame.
-const CLASS_NONE: u8 = 2;
 
 /// The silhouette evidence of one camera at one state.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -71,6 +71,27 @@ pub fn covers(view: &ProjectedModel, camera: &Camera, p: &Vector2<f32>) -> bool 
             .is_some_and(|palm| palm.depth_at(camera, p).is_some())
 }
 
+/// [`covers`] restricted to the links `among` (indices into `view.links`) and the palm if
+/// given: the same answer when they are every part whose bounds could hold `p`.
+fn covers_among(
+    view: &ProjectedModel,
+    camera: &Camera,
+    among: &[u8],
+    palm: Option<&ProjectedPalm>,
+    p: &Vector2<f32>,
+) -> bool {
+    let in_link = among.iter().any(|&k| {
+        view.links.get(usize::from(k)).is_some_and(|link| {
+            if !link.bounds.contains(p) {
+                return false;
+            }
+            let (s, dist) = link.closest(p);
+            dist < link.radius_at(s)
+        })
+    });
+    in_link || palm.is_some_and(|palm| palm.depth_at(camera, p).is_some())
+}
+
 /// The image bounds of everything projected, or `None` when nothing is.
 pub fn hand_bounds(view: &ProjectedModel) -> Option<Bounds> {
     let mut all = view
@@ -102,23 +123,37 @@ pub fn score(
     }
     let min = bounds.min - size * MARGIN;
     let step = size * (1.0 + 2.0 * MARGIN) / (grid - 1) as f32;
-    // One pass classifies and samples (kept as bytes: 2.3 KB at most on the stack), a second
-    // counts the agreement with the midpoint between the class means.
-    let mut value = [0u8; MAX_GRID * MAX_GRID];
-    let mut class = [CLASS_NONE; MAX_GRID * MAX_GRID];
+    // One pass classifies and samples, counting each class's grey levels (rounded) in a
+    // histogram (1 KB on the stack); the agreement with the midpoint between the class means
+    // is then counted from the histograms.
+    let mut levels = [[0u16; 256]; 2];
+    let (mut lowest, mut highest) = (u8::MAX, 0u8);
     let mut sum = [0.0f32; 2];
     let mut sum_sq = [0.0f32; 2];
     let mut count = [0u32; 2];
     for j in 0..grid {
+        let y = min.y + step.y * j as f32;
+        // The parts whose bounds span this row: no other part covers a point of it.
+        let mut row: Vec<u8, MAX_LINKS> = Vec::new();
+        for (k, link) in view.links.iter().enumerate() {
+            if link.bounds.min.y <= y && y <= link.bounds.max.y {
+                let _ = row.push(k as u8);
+            }
+        }
+        let palm = view
+            .palm
+            .as_ref()
+            .filter(|palm| palm.bounds.min.y <= y && y <= palm.bounds.max.y);
         for i in 0..grid {
-            let p = Vector2::new(min.x + step.x * i as f32, min.y + step.y * j as f32);
+            let p = Vector2::new(min.x + step.x * i as f32, y);
             let Some(v) = frame.sample(p.x, p.y) else {
                 continue;
             };
-            let k = usize::from(covers(view, camera, &p));
-            let at = j * grid + i;
-            value[at] = (v + 0.5) as u8;
-            class[at] = k as u8;
+            let k = usize::from(covers_among(view, camera, &row, palm, &p));
+            let level = (v + 0.5) as u8;
+            levels[k][usize::from(level)] += 1;
+            lowest = lowest.min(level);
+            highest = highest.max(level);
             sum[k] += v;
             sum_sq[k] += v * v;
             count[k] += 1;
@@ -136,12 +171,14 @@ pub fn score(
     let contrast = mean[1] - mean[0];
     let separation = contrast * contrast / (var[0] + var[1]).max(1.0);
     let threshold = 0.5 * (mean[0] + mean[1]);
-    // The hand is the brighter class.
-    let agree = value[..grid * grid]
-        .iter()
-        .zip(&class[..grid * grid])
-        .filter(|(v, c)| **c != CLASS_NONE && (f32::from(**v) > threshold) == (**c == 1))
-        .count() as u32;
+    // The hand is the brighter class: inside samples above the threshold agree, and outside
+    // ones at or below it.
+    let agree: u32 = (lowest..=highest)
+        .map(|level| {
+            let class = usize::from(f32::from(level) > threshold);
+            u32::from(levels[class][usize::from(level)])
+        })
+        .sum();
     Some(SilhouetteScore {
         contrast,
         separation,

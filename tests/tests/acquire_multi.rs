@@ -277,10 +277,12 @@ fn claimed_tip_errors(
 #[test]
 fn the_confirm_phase_keeps_the_leaf_better_over_its_frames_not_on_the_last() {
     let dir = tempfile::tempdir().unwrap();
-    // A seed of the fresh sweep (1731-1830) this was found on: after the acquisition on
-    // frame 6, a wrong leaf (13-15 px) and a right one (4 px from frame 9) are carried; the
-    // right one scores more by 0.005 on frames 9 and 10, under the switch margin of 0.01.
-    let sequence = common::seeded(dir.path(), "random-stereo", 1751, 16);
+    // A seed of the sweep this shows on (found among the even seeds 2032-2430 under the
+    // search's budget of 100 a frame; until then it was seed 1751, which both rankings now
+    // hold right from frame 10): after the acquisition, ranked by the frame under the switch
+    // margin of 0.01 the output stays on a leaf 11-12 px off through frame 15; ranked by the
+    // running mean it moves to a right one (1.4-1.7 px) from frame 7.
+    let sequence = common::seeded(dir.path(), "random-stereo", 2046, 16);
     let ranked_by_the_frame = FinderConfig {
         confirm_switch_margin: 0.01,
         confirm_score_memory: 0.0,

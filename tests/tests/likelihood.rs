@@ -175,3 +175,174 @@ fn the_chamfer_summed_as_points_are_made_is_the_buffered_samples() {
     assert!(with_hidden > 0, "no view had hidden points");
     assert!(with_outside > 0, "no view had points outside the frame");
 }
+
+/// The states the bound and silhouette tests score: the truth and perturbations of it, near
+/// and far, so that some score high and some low.
+fn scored_states(q: &[f32]) -> Vec<Vec<f32>> {
+    let mut states = Vec::new();
+    for dx in [0.0, 8.0, -25.0, 60.0] {
+        for angle in [0.0, 0.3, -0.9] {
+            for bend in [0.0, 0.4, -0.3] {
+                states.push(perturbed(q, dx, angle, bend));
+            }
+        }
+    }
+    states
+}
+
+/// `StateScorer::score_above` gives `score`'s mean bit for bit whenever it gives a score,
+/// and gives none only when that mean is at or under the bar: it skips only terms that
+/// could not lift the score over. On the truth and 35 perturbations of it, in one camera
+/// and two, against bars below, at and above each state's score.
+#[test]
+fn the_bounded_score_is_the_score_or_proves_it_is_under_the_bar() {
+    use digiteyes_core::likelihood::StateScorer;
+    let dir = tempfile::tempdir().unwrap();
+    let config = LikelihoodConfig::default();
+    let (mut scored, mut refused, mut silhouettes_skipped, mut cameras_skipped) = (0, 0, 0, 0);
+    for (scenario, seed) in [("random-mono", 203), ("random-stereo", 204)] {
+        let sequence = common::seeded(dir.path(), scenario, seed, 1);
+        let truth = sequence.read_truth().unwrap();
+        let q: Vec<f32> = truth.rows[0].iter().map(|&v| v as f32).collect();
+        let images: Vec<_> = (0..sequence.cameras.len())
+            .map(|k| sequence.read_frame(k, 0).unwrap())
+            .collect();
+        let frames: Vec<FrameView> = images
+            .iter()
+            .map(|i| FrameView::packed(i.as_raw(), i.width() as usize, i.height() as usize))
+            .collect::<Result<_, _>>()
+            .unwrap();
+        let mut buffers: Vec<Vec<u8>> = frames
+            .iter()
+            .map(|f| vec![0u8; EdgeMap::bytes_needed(f.width(), f.height(), config.stride_px)])
+            .collect();
+        let edges: Vec<EdgeMap> = buffers
+            .iter_mut()
+            .zip(&frames)
+            .map(|(b, f)| EdgeMap::build(b, f, &config).unwrap())
+            .collect();
+        let cameras = &sequence.cameras;
+        let mut scorer = StateScorer::new();
+        for p in scored_states(&q) {
+            let score = scorer.score(&sequence.model, cameras, &frames, &edges, &p, &config);
+            for bar in [
+                f32::NEG_INFINITY,
+                score - 0.05,
+                score - 1e-6,
+                score,
+                score + 0.02,
+                0.6,
+                0.85,
+            ] {
+                let bounded =
+                    scorer.score_above(&sequence.model, cameras, &frames, &edges, &p, &config, bar);
+                let label = format!("{scenario} {seed}: score {score}, bar {bar}");
+                match bounded.score {
+                    Some(s) => {
+                        assert_eq!(s.to_bits(), score.to_bits(), "{label}");
+                        assert_eq!(bounded.edge_terms as usize, cameras.len(), "{label}");
+                        scored += 1;
+                    }
+                    None => {
+                        assert!(score <= bar, "{label}: refused a score over its bar");
+                        refused += 1;
+                        silhouettes_skipped +=
+                            usize::from(bounded.silhouette_terms < bounded.edge_terms);
+                        cameras_skipped +=
+                            usize::from((bounded.edge_terms as usize) < cameras.len());
+                    }
+                }
+                if bar < score {
+                    assert!(
+                        bounded.score.is_some(),
+                        "{label}: refused a score over its bar"
+                    );
+                }
+            }
+        }
+    }
+    assert!(
+        scored > 0 && refused > 0,
+        "scored {scored}, refused {refused}"
+    );
+    assert!(silhouettes_skipped > 0, "no silhouette term was skipped");
+    assert!(cameras_skipped > 0, "no camera was skipped");
+}
+
+/// The silhouette score counts each class's grey levels in histograms and tests only the
+/// parts whose bounds span a grid row; a plain per-point count over every part (the score
+/// as first written) gives the same figures, bit for bit, at the search's grids.
+#[test]
+fn the_silhouette_score_is_the_plain_per_point_count() {
+    use digiteyes_core::nalgebra::Vector2;
+    use digiteyes_core::silhouette::{self, covers, hand_bounds, MARGIN, MIN_CLASS_SAMPLES};
+    let dir = tempfile::tempdir().unwrap();
+    let mut compared = 0;
+    for (scenario, seed) in [
+        ("fullhand-mono", 1),
+        ("random-mono", 203),
+        ("random-mono", 205),
+    ] {
+        let sequence = common::seeded(dir.path(), scenario, seed, 1);
+        let truth = sequence.read_truth().unwrap();
+        let q: Vec<f32> = truth.rows[0].iter().map(|&v| v as f32).collect();
+        let image = sequence.read_frame(0, 0).unwrap();
+        let (w, h) = (image.width() as usize, image.height() as usize);
+        let frame = FrameView::packed(image.as_raw(), w, h).unwrap();
+        let camera = &sequence.cameras[0];
+        for p in scored_states(&q) {
+            let poses = Poses::compute(&sequence.model, &p).unwrap();
+            let mut view = ProjectedModel::new();
+            view.update(&sequence.model, &poses, camera, 4.0);
+            for grid in [10usize, 16, 24] {
+                let fast = silhouette::score(&view, camera, &frame, grid);
+                // The plain count.
+                let plain = hand_bounds(&view).and_then(|bounds| {
+                    let size = bounds.max - bounds.min;
+                    let min = bounds.min - size * MARGIN;
+                    let step = size * (1.0 + 2.0 * MARGIN) / (grid - 1) as f32;
+                    let mut samples = Vec::new();
+                    let (mut sum, mut sum_sq, mut count) = ([0.0f32; 2], [0.0f32; 2], [0u32; 2]);
+                    for j in 0..grid {
+                        for i in 0..grid {
+                            let x = min.x + step.x * i as f32;
+                            let y = min.y + step.y * j as f32;
+                            let Some(v) = frame.sample(x, y) else {
+                                continue;
+                            };
+                            let k = usize::from(covers(&view, camera, &Vector2::new(x, y)));
+                            samples.push(((v + 0.5) as u8, k));
+                            sum[k] += v;
+                            sum_sq[k] += v * v;
+                            count[k] += 1;
+                        }
+                    }
+                    if count[0] < MIN_CLASS_SAMPLES || count[1] < MIN_CLASS_SAMPLES {
+                        return None;
+                    }
+                    let mean = [sum[0] / count[0] as f32, sum[1] / count[1] as f32];
+                    let var = [
+                        (sum_sq[0] / count[0] as f32 - mean[0] * mean[0]).max(0.0),
+                        (sum_sq[1] / count[1] as f32 - mean[1] * mean[1]).max(0.0),
+                    ];
+                    let contrast = mean[1] - mean[0];
+                    let threshold = 0.5 * (mean[0] + mean[1]);
+                    let agree = samples
+                        .iter()
+                        .filter(|(v, k)| (f32::from(*v) > threshold) == (*k == 1))
+                        .count() as u32;
+                    Some(silhouette::SilhouetteScore {
+                        contrast,
+                        separation: contrast * contrast / (var[0] + var[1]).max(1.0),
+                        agreement: agree as f32 / (count[0] + count[1]) as f32,
+                        inside: count[1],
+                        outside: count[0],
+                    })
+                });
+                assert_eq!(fast, plain, "{scenario} {seed}, grid {grid}");
+                compared += usize::from(plain.is_some());
+            }
+        }
+    }
+    assert!(compared > 200, "only {compared} scores compared");
+}

@@ -82,13 +82,16 @@ fn no_frame_of_1000_hand_free_ones_is_claimed() {
         assert_eq!(claims, 0, "{rig}: hand-free frames claimed");
         if rig == "random-mono" {
             // With the tracker's region rows (on by default) no clutter leaf is accepted on
-            // this rig; without them the search accepts clutter twice in the 1,000 frames,
-            // and claimed on the accepting frame they would be 3 frames claimed. The
-            // probation is put to the test there.
+            // this rig. Without them, and with the one-camera bar at 0.91 instead of 0.93,
+            // the search accepts clutter once in the 1,000 frames, and claimed on the
+            // accepting frame it would be 4 frames claimed: the probation is put to the test
+            // there. (Until the search's budget of 100 a frame, the default bar accepted
+            // clutter twice here without the rows; no mono rig of 1411-1481 does now.)
             let mut plain = TrackerConfig::default();
             plain.fill = FillConfig::OFF;
-            let (claims, accepted, _) =
-                hand_free_run(&sequence, FinderConfig::default(), plain, 1000);
+            let mut lenient = FinderConfig::default();
+            lenient.accept.one_camera_score = 0.91;
+            let (claims, accepted, _) = hand_free_run(&sequence, lenient, plain, 1000);
             assert_eq!(
                 claims, 0,
                 "{rig}: hand-free frames claimed without region rows"
@@ -99,7 +102,7 @@ fn no_frame_of_1000_hand_free_ones_is_claimed() {
             );
             let at_once = FinderConfig {
                 probation_max_drop: None,
-                ..FinderConfig::default()
+                ..lenient
             };
             let (claims_at_once, _, _) = hand_free_run(&sequence, at_once, plain, 1000);
             println!("{rig} {seed}: claimed on acceptance, {claims_at_once} frames claimed");

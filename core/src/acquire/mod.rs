@@ -27,7 +27,7 @@ use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
-use crate::likelihood::{mean_score, EdgeMap, Likelihood, LikelihoodConfig, Region, Samples};
+use crate::likelihood::{BoundedScore, EdgeMap, Likelihood, LikelihoodConfig, Region, Samples};
 use crate::model::Model;
 use crate::nalgebra::{Vector2, Vector3};
 
@@ -51,10 +51,30 @@ use rotation::{axis_angle, coarse_rotation, compose};
 /// Chamfer look-ups a slide ([`Acquirer::place`]) may make for the cost of one evaluation.
 pub const LOOKUPS_PER_EVALUATION: u32 = 600;
 
-/// What one camera's coarse-level evaluation is charged against the budget, as a share of a
-/// full one: its cheaper score (3 points per silhouette line instead of 6, a 10×10 silhouette
-/// grid instead of 16×16) costs about half (docs/performance.md). Charged as 1 in 2.
-pub const COARSE_EVALUATION_SHARE: f32 = 0.5;
+/// What one hypothesis costs against the budget, camera by camera, in eighths of an
+/// evaluation (one camera's chamfer and silhouette terms at the tree's sampling): the shares
+/// of its instructions measured on x86-64 (docs/performance.md, "A bound on each
+/// hypothesis' score"), rounded up but for the coarse level's edges-only case.
+pub mod charge {
+    /// Eighths in one evaluation.
+    pub const EIGHTHS: u32 = 8;
+    /// A camera scored in full at the tree's sampling.
+    pub const FULL: u32 = 8;
+    /// A camera whose silhouette term the bound left out.
+    pub const EDGES_ONLY: u32 = 5;
+    /// A camera scored in full on the coarse level's cheaper sampling.
+    pub const COARSE_FULL: u32 = 6;
+    /// The same with the silhouette term left out.
+    pub const COARSE_EDGES_ONLY: u32 = 4;
+    /// A camera the bound left unscored: its share of placing and posing the hypothesis.
+    pub const UNSCORED: u32 = 2;
+
+    // A full evaluation is one; each part of one costs less, and a coarse score less than
+    // the tree's.
+    const _: () = assert!(FULL == EIGHTHS);
+    const _: () = assert!(EDGES_ONLY < FULL && COARSE_FULL < FULL && UNSCORED < EDGES_ONLY);
+    const _: () = assert!(COARSE_EDGES_ONLY < COARSE_FULL && UNSCORED < COARSE_EDGES_ONLY);
+}
 
 /// Variants of a state [`Acquirer::variant`] gives: itself, six turns, two depths.
 pub const LOCAL_VARIANTS: u32 = 9;
@@ -83,9 +103,10 @@ const COARSE_POSES: [FingerPose; POSE_COUNT] = [
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct AcquireConfig {
     /// Work per [`Acquirer::step`] at most, in evaluations per camera: one hypothesis scored
-    /// in one camera counts 1, on the coarse level's cheaper score
-    /// ([`AcquireConfig::coarse_sampling`]) [`COARSE_EVALUATION_SHARE`] of one (a slide by
-    /// [`Acquirer::place`] counts its chamfer look-ups over [`LOOKUPS_PER_EVALUATION`]). A
+    /// in full in one camera counts 1; the coarse level's cheaper score
+    /// ([`AcquireConfig::coarse_sampling`]) and the terms the score's bound leaves out count
+    /// less ([`charge`]; a slide by [`Acquirer::place`] counts its chamfer look-ups over
+    /// [`LOOKUPS_PER_EVALUATION`]). A
     /// step with two cameras may spend twice this, so a stereo search scores as many
     /// hypotheses per frame as a mono one, and a searching frame costs about the same
     /// multiple of a tracking frame (which also costs twice) in either rig.
@@ -123,7 +144,7 @@ pub struct AcquireConfig {
 impl Default for AcquireConfig {
     fn default() -> Self {
         AcquireConfig {
-            evaluations_per_frame: 70,
+            evaluations_per_frame: 100,
             depths: 3,
             slide_step: 1.0 / 20.0,
             normals: 20,
@@ -188,8 +209,8 @@ pub struct Acquirer {
     pub evaluations: u32,
     /// Chamfer look-ups of the slide under way (what it costs against the budget).
     lookups: u32,
-    /// Coarse camera evaluations not yet charged (every second one is).
-    coarse_uncharged: u32,
+    /// Eighths of an evaluation spent and not yet charged ([`charge`]).
+    uncharged_eighths: u32,
     /// The most one hypothesis or slide has cost (evaluations): how far a step can overrun
     /// its budget, since the last item is finished once begun.
     pub largest_item_cost: u16,
@@ -227,7 +248,7 @@ impl Acquirer {
             scratch: Scratch::new(),
             evaluations: 0,
             lookups: 0,
-            coarse_uncharged: 0,
+            uncharged_eighths: 0,
             largest_item_cost: 0,
             last_step_cost: 0,
         }
@@ -245,7 +266,7 @@ impl Acquirer {
         self.best.clear();
         self.next.clear();
         self.evaluations = 0;
-        self.coarse_uncharged = 0;
+        self.uncharged_eighths = 0;
     }
 
     /// The parameters.
@@ -342,28 +363,33 @@ impl Acquirer {
                 },
                 _ => self.config.likelihood,
             };
-            let mut each = [Likelihood::default(); MAX_CAMERAS];
-            let n = self.scratch.likelihoods(
+            // A hypothesis that cannot beat the last of a full list is not kept: the terms
+            // that could not lift it over are not computed.
+            let bar = match self.next.last() {
+                Some(last) if self.next.is_full() => last.score,
+                _ => f32::NEG_INFINITY,
+            };
+            let bounded = self.scratch.score_above(
                 model,
                 cameras,
                 frames,
                 edges,
                 &q[..self.n_states],
                 &likelihood,
-                &mut each,
+                bar,
             );
-            let score = mean_score(&each[..n]);
-            keep(&mut self.next, Candidate { score, q });
-            let scored = n_cameras.max(1) as u32;
-            let charged = if matches!(self.stage, Stage::Coarse(_)) {
-                // Half of the coarse evaluations are charged, the rest carried to the next.
-                let all = self.coarse_uncharged + scored;
-                self.coarse_uncharged = all % 2;
-                all / 2
-            } else {
-                scored
-            };
-            evaluated = evaluated.saturating_add(self.finish_item(charged));
+            if let Some(score) = bounded.score {
+                keep(&mut self.next, Candidate { score, q });
+            }
+            let eighths = spent_eighths(
+                &bounded,
+                n_cameras.max(1) as u32,
+                matches!(self.stage, Stage::Coarse(_)),
+            );
+            // Whole evaluations are charged, the rest carried to the next hypothesis.
+            let all = self.uncharged_eighths + eighths;
+            self.uncharged_eighths = all % charge::EIGHTHS;
+            evaluated = evaluated.saturating_add(self.finish_item(all / charge::EIGHTHS));
         }
         self.last_step_cost = evaluated;
         match (self.stage, self.best.first()) {
@@ -823,6 +849,19 @@ impl Acquirer {
     }
 }
 
+/// What scoring one hypothesis in `cameras` cameras cost, in eighths of an evaluation
+/// ([`charge`]): each camera by the terms its score computed.
+fn spent_eighths(bounded: &BoundedScore, cameras: u32, coarse: bool) -> u32 {
+    let (full, edges_only) = if coarse {
+        (charge::COARSE_FULL, charge::COARSE_EDGES_ONLY)
+    } else {
+        (charge::FULL, charge::EDGES_ONLY)
+    };
+    let edges = u32::from(bounded.edge_terms).min(cameras);
+    let silhouettes = u32::from(bounded.silhouette_terms).min(edges);
+    silhouettes * full + (edges - silhouettes) * edges_only + (cameras - edges) * charge::UNSCORED
+}
+
 /// Keeps `c` among the best [`MAX_KEEP`] of `list` (sorted, best first).
 fn keep(list: &mut Vec<Candidate, MAX_KEEP>, c: Candidate) {
     if !c.score.is_finite() {
@@ -845,6 +884,33 @@ fn keep(list: &mut Vec<Candidate, MAX_KEEP>, c: Candidate) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_hypothesis_is_charged_for_the_terms_its_score_computed() {
+        let spent = |edge_terms, silhouette_terms, cameras, coarse| {
+            let bounded = BoundedScore {
+                score: None,
+                edge_terms,
+                silhouette_terms,
+            };
+            spent_eighths(&bounded, cameras, coarse)
+        };
+        // Scored in full: one evaluation a camera on the tree, less on the coarse level.
+        assert_eq!(spent(1, 1, 1, false), charge::EIGHTHS);
+        assert_eq!(spent(2, 2, 2, false), 2 * charge::EIGHTHS);
+        assert_eq!(spent(1, 1, 1, true), charge::COARSE_FULL);
+        // The silhouette left out by the bound, then a whole second camera.
+        assert_eq!(spent(1, 0, 1, false), charge::EDGES_ONLY);
+        assert_eq!(spent(2, 1, 2, false), charge::FULL + charge::EDGES_ONLY);
+        assert_eq!(spent(1, 1, 2, true), charge::COARSE_FULL + charge::UNSCORED);
+        assert_eq!(
+            spent(1, 0, 2, true),
+            charge::COARSE_EDGES_ONLY + charge::UNSCORED
+        );
+        // Not posed: only the placing is charged. Counts past the cameras are clamped.
+        assert_eq!(spent(0, 0, 2, false), 2 * charge::UNSCORED);
+        assert_eq!(spent(3, 5, 2, false), 2 * charge::FULL);
+    }
 
     #[test]
     fn keep_holds_the_best_in_order() {

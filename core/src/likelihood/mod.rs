@@ -24,7 +24,7 @@ pub use edges::{EdgeMap, EDGE_BINS, GRADIENT_STEP_PX};
 pub use region::{Region, EXTENT_PERCENTILE, MAX_EXTENT_BINS, MIN_REGION_SAMPLES};
 use samples::ChamferSum;
 pub use samples::{visit, Samples, SilhouettePoint, MAX_SAMPLES, MAX_SAMPLES_PER_LINE};
-pub use state::{mean_score, StateScorer, MIN_LINK_PX};
+pub use state::{mean_score, BoundedScore, StateScorer, MIN_LINK_PX};
 
 /// Parameters of the edge map and of the score.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -115,6 +115,20 @@ pub fn evaluate(
     edges: &EdgeMap<'_>,
     config: &LikelihoodConfig,
 ) -> Likelihood {
+    let mut likelihood = evaluate_edges(view, camera, edges, config);
+    add_silhouette(&mut likelihood, view, camera, frame, config);
+    likelihood
+}
+
+/// The chamfer half of [`evaluate`]: every field but the silhouette's, and a `score` that
+/// [`add_silhouette`] can only lower — the score with a perfect silhouette agreement, or 0
+/// (final) when no silhouette point lies in the frame.
+pub(crate) fn evaluate_edges(
+    view: &ProjectedModel,
+    camera: &Camera,
+    edges: &EdgeMap<'_>,
+    config: &LikelihoodConfig,
+) -> Likelihood {
     let cap = config.chamfer_cap_px.max(1e-3);
     // The chamfer term of each visible silhouette point as it is visited: no buffer of points
     // (`Samples::chamfer`'s sum, in the same order).
@@ -129,23 +143,55 @@ pub fn evaluate(
             ..Likelihood::default()
         };
     }
-    let silhouette = (config.silhouette_grid > 0)
-        .then(|| crate::silhouette::score(view, camera, frame, usize::from(config.silhouette_grid)))
-        .flatten()
-        .map(|s| s.agreement);
-    let w = config.silhouette_weight.clamp(0.0, 1.0);
-    let edge_term = 1.0 - chamfer_px / cap;
-    let score = match silhouette {
-        Some(a) => (1.0 - w) * edge_term + w * a,
-        None => (1.0 - w) * edge_term,
-    };
     Likelihood {
         chamfer_px,
         points: inside,
         points_outside: outside,
         points_hidden: hidden,
-        silhouette,
-        score,
+        silhouette: None,
+        score: combine(edge_term(chamfer_px, config), Some(1.0), config),
+    }
+}
+
+/// Completes [`evaluate_edges`]' `likelihood` with the silhouette term and the final score;
+/// nothing to add when no silhouette point lay in the frame.
+pub(crate) fn add_silhouette(
+    likelihood: &mut Likelihood,
+    view: &ProjectedModel,
+    camera: &Camera,
+    frame: &FrameView<'_>,
+    config: &LikelihoodConfig,
+) {
+    if likelihood.points == 0 {
+        return;
+    }
+    let silhouette = (config.silhouette_grid > 0)
+        .then(|| crate::silhouette::score(view, camera, frame, usize::from(config.silhouette_grid)))
+        .flatten()
+        .map(|s| s.agreement);
+    likelihood.silhouette = silhouette;
+    likelihood.score = combine(edge_term(likelihood.chamfer_px, config), silhouette, config);
+}
+
+/// The highest score [`evaluate`] can give under `config`: a camera not yet scored counts
+/// this much in a bound.
+pub(crate) fn ceiling(config: &LikelihoodConfig) -> f32 {
+    combine(1.0, Some(1.0), config)
+}
+
+/// The chamfer term, 1 with every point on an edge and 0 at the cap.
+fn edge_term(chamfer_px: f32, config: &LikelihoodConfig) -> f32 {
+    1.0 - chamfer_px / config.chamfer_cap_px.max(1e-3)
+}
+
+/// The combined score of an edge term and a silhouette agreement (0..=1 each). One
+/// expression for the score and its bounds: it rises with each argument, so a bound built
+/// from larger arguments is never under the score.
+fn combine(edge_term: f32, silhouette: Option<f32>, config: &LikelihoodConfig) -> f32 {
+    let w = config.silhouette_weight.clamp(0.0, 1.0);
+    match silhouette {
+        Some(a) => (1.0 - w) * edge_term + w * a,
+        None => (1.0 - w) * edge_term,
     }
 }
 

@@ -10,7 +10,9 @@ use crate::kinematics::Poses;
 use crate::model::Model;
 use crate::projection::ProjectedModel;
 
-use super::{evaluate, EdgeMap, Likelihood, LikelihoodConfig};
+use super::{
+    add_silhouette, ceiling, evaluate, evaluate_edges, EdgeMap, Likelihood, LikelihoodConfig,
+};
 
 /// Shortest link drawn when scoring (px): the tracker's own default.
 pub const MIN_LINK_PX: f32 = 4.0;
@@ -84,6 +86,62 @@ impl StateScorer {
         n
     }
 
+    /// The mean score of `q` over the cameras, bit for bit [`Self::score`]'s, unless that
+    /// mean cannot exceed `bar`: then the score is `None`, found without the terms that could
+    /// not have lifted it over. Before each camera's silhouette term, and before each further
+    /// camera, the mean is bounded from above by the [`evaluate_edges`] bound for a camera
+    /// whose edges are scored and the [`ceiling`] for one not yet scored; a bound at or
+    /// under `bar` ends it. What was computed is counted in the result, so a caller can
+    /// charge for it.
+    #[allow(clippy::too_many_arguments)] // `score`'s arguments and the bar
+    pub fn score_above(
+        &mut self,
+        model: &Model,
+        cameras: &[Camera],
+        frames: &[FrameView<'_>],
+        edges: &[EdgeMap<'_>],
+        q: &[f32],
+        config: &LikelihoodConfig,
+        bar: f32,
+    ) -> BoundedScore {
+        let mut out = BoundedScore::default();
+        if !self.pose(model, q) {
+            out.score = Some(0.0);
+            return out;
+        }
+        let n = cameras
+            .len()
+            .min(frames.len())
+            .min(edges.len())
+            .min(MAX_CAMERAS);
+        let mut each = [Likelihood {
+            score: ceiling(config),
+            ..Likelihood::default()
+        }; MAX_CAMERAS];
+        for (k, ((camera, frame), edges)) in
+            cameras.iter().zip(frames).zip(edges).enumerate().take(n)
+        {
+            if mean_score(&each[..n]) <= bar {
+                return out;
+            }
+            if !self.project(model, camera) {
+                out.score = Some(0.0);
+                return out;
+            }
+            each[k] = evaluate_edges(&self.view, camera, edges, config);
+            out.edge_terms += 1;
+            if mean_score(&each[..n]) <= bar {
+                return out;
+            }
+            if each[k].points > 0 {
+                add_silhouette(&mut each[k], &self.view, camera, frame, config);
+                out.silhouette_terms += 1;
+            }
+        }
+        out.score = Some(mean_score(&each[..n]));
+        out
+    }
+
     /// The mean and the worst camera's likelihood score of `q` (0..=1, higher is better);
     /// both 0 when `q` cannot be posed or no camera is given.
     pub fn score_cameras(
@@ -121,6 +179,18 @@ impl StateScorer {
         self.score_cameras(model, cameras, frames, edges, q, config)
             .0
     }
+}
+
+/// A score [`StateScorer::score_above`] computed, or found not to exceed its bar.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct BoundedScore {
+    /// The mean score over the cameras, or `None` when it could not exceed the bar.
+    pub score: Option<f32>,
+    /// Cameras whose chamfer term was computed.
+    pub edge_terms: u8,
+    /// Cameras whose silhouette term was computed.
+    pub silhouette_terms: u8,
 }
 
 /// The mean score of `each` (0 for none).

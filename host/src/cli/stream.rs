@@ -76,7 +76,7 @@ pub struct StreamArgs {
     #[arg(long, value_enum)]
     pub init: Option<InitArg>,
     /// The board's search budget: evaluations per frame and camera at most while it searches, 1 to
-    /// 65535 (default: the search's, 70). Lower keeps a searching frame's time nearer a
+    /// 65535 (default: the search's, 100). Lower keeps a searching frame's time nearer a
     /// tracking frame's; the search then takes more frames.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
     pub search_evaluations: Option<u16>,
