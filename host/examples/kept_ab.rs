@@ -7,7 +7,8 @@
 //! hypotheses (their count, scoring period, samples, score memory, switch margin); `csmem`,
 //! `cswitch` the confirm phase's score memory and switch margin; `watch`
 //! its period, `drop` its bar; `depth1` one camera's local depth share; `probation` the acceptance's
-//! probation drop, negative: off). Each group's row also gives
+//! probation drop, negative: off; `budget` the search's evaluations a frame and camera).
+//! Each group's row also gives
 //! its frames far from the hand and not flagged (`far`) and the lost flag's precision and
 //! recall (`lostP`, `lostR`), as the benchmark counts them.
 //! Every variant after the first is also compared with the first seed by seed (paired):

@@ -108,6 +108,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "drop" => o.watch.max_drop = f,
             "depth1" => o.finder.local_depth_share[1] = f,
             "probation" => o.finder.probation_max_drop = (f >= 0.0).then_some(f),
+            "budget" => o.acquire.evaluations_per_frame = f as u16,
             _ => bail!("unknown key {k}"),
         }
     }
