@@ -81,6 +81,9 @@ struct Args {
     tree_levels: Option<u8>,
     #[arg(long)]
     tree_pose_levels: Option<u8>,
+    /// The tree's first steps: palm turn (rad), depth (share of the depth, one camera).
+    #[arg(long, value_parser = parse_pair)]
+    tree_steps: Option<[f32; 2]>,
     #[arg(long)]
     rounds: Option<u8>,
     #[arg(long)]
@@ -222,6 +225,13 @@ fn parse_range(s: &str) -> Result<RangeInclusive<u64>, String> {
     Ok(a.parse().map_err(|_| "A")?..=b.parse().map_err(|_| "B")?)
 }
 
+/// Two numbers, `A,B`.
+fn parse_pair(s: &str) -> Result<[f32; 2], String> {
+    let (a, b) = s.split_once(',').ok_or("expected two numbers, A,B")?;
+    let number = |t: &str| t.trim().parse::<f32>().map_err(|e| format!("{t}: {e}"));
+    Ok([number(a)?, number(b)?])
+}
+
 fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
     let d = AcquireConfig::default();
     let acquire = AcquireConfig {
@@ -231,6 +241,7 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         coarse_poses: args.coarse_poses.unwrap_or(d.coarse_poses),
         tree_levels: args.tree_levels.unwrap_or(d.tree_levels),
         tree_pose_levels: args.tree_pose_levels.unwrap_or(d.tree_pose_levels),
+        tree_steps: args.tree_steps.unwrap_or(d.tree_steps),
         refine_rounds: args.rounds.unwrap_or(d.refine_rounds),
         refine_seeds: args.refine_seeds.unwrap_or(d.refine_seeds),
         coarse_sampling: match args.coarse_sampling.as_deref() {
