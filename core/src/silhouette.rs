@@ -27,7 +27,7 @@ use crate::frame::FrameView;
 use heapless::Vec;
 
 use crate::config::MAX_LINKS;
-use crate::projection::{Bounds, ProjectedModel, ProjectedPalm};
+use crate::projection::{Bounds, ProjectedLink, ProjectedModel, ProjectedPalm};
 
 /// Samples along each side of the grid, at most.
 pub const MAX_GRID: usize = 48;
@@ -57,14 +57,7 @@ pub struct SilhouetteScore {
 
 /// Whether the projected hand covers image point `p` (a capsule link or the palm box).
 pub fn covers(view: &ProjectedModel, camera: &Camera, p: &Vector2<f32>) -> bool {
-    let in_link = view.links.iter().any(|link| {
-        if !link.bounds.contains(p) {
-            return false;
-        }
-        let (s, dist) = link.closest(p);
-        dist < link.radius_at(s)
-    });
-    in_link
+    view.links.iter().any(|link| link_covers(link, p))
         || view
             .palm
             .as_ref()
@@ -80,16 +73,20 @@ fn covers_among(
     palm: Option<&ProjectedPalm>,
     p: &Vector2<f32>,
 ) -> bool {
-    let in_link = among.iter().any(|&k| {
-        view.links.get(usize::from(k)).is_some_and(|link| {
-            if !link.bounds.contains(p) {
-                return false;
-            }
-            let (s, dist) = link.closest(p);
-            dist < link.radius_at(s)
-        })
-    });
-    in_link || palm.is_some_and(|palm| palm.depth_at(camera, p).is_some())
+    among.iter().any(|&k| {
+        view.links
+            .get(usize::from(k))
+            .is_some_and(|link| link_covers(link, p))
+    }) || palm.is_some_and(|palm| palm.depth_at(camera, p).is_some())
+}
+
+/// Whether `link`'s capsule covers image point `p`.
+fn link_covers(link: &ProjectedLink, p: &Vector2<f32>) -> bool {
+    if !link.bounds.contains(p) {
+        return false;
+    }
+    let (s, dist) = link.closest(p);
+    dist < link.radius_at(s)
 }
 
 /// The image bounds of everything projected, or `None` when nothing is.
