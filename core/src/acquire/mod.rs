@@ -54,7 +54,8 @@ pub const LOOKUPS_PER_EVALUATION: u32 = 600;
 /// What one hypothesis costs against the budget, camera by camera, in eighths of an
 /// evaluation (one camera's chamfer and silhouette terms at the tree's sampling): the shares
 /// of its instructions measured on x86-64 (docs/performance.md, "A bound on each
-/// hypothesis' score"), rounded up but for the coarse level's edges-only case.
+/// hypothesis' score"), rounded to the nearest eighth (the coarse level's full score, 5.5,
+/// up).
 pub mod charge {
     /// Eighths in one evaluation.
     pub const EIGHTHS: u32 = 8;
