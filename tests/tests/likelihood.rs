@@ -36,6 +36,12 @@ fn score(sequence: &Sequence, k: usize, q: &[f32], blank: bool) -> Likelihood {
     evaluate(&view, camera, &frame, &edges, &config)
 }
 
+/// The true state of `sequence`'s first frame.
+fn first_true_state(sequence: &Sequence) -> Vec<f32> {
+    let truth = sequence.read_truth().unwrap();
+    truth.rows[0].iter().map(|&v| v as f32).collect()
+}
+
 /// `q` with the palm moved `dx` mm along x, turned `angle` rad about its z axis, and every
 /// finger joint flexed by `bend` rad.
 fn perturbed(q: &[f32], dx: f32, angle: f32, bend: f32) -> Vec<f32> {
@@ -138,8 +144,7 @@ fn the_chamfer_summed_as_points_are_made_is_the_buffered_samples() {
     let mut with_outside = 0;
     for (scenario, seed) in [("fullhand-mono", 1), ("random-mono", 203)] {
         let sequence = common::seeded(dir.path(), scenario, seed, 1);
-        let truth = sequence.read_truth().unwrap();
-        let q: Vec<f32> = truth.rows[0].iter().map(|&v| v as f32).collect();
+        let q = first_true_state(&sequence);
         let image = sequence.read_frame(0, 0).unwrap();
         let (w, h) = (image.width() as usize, image.height() as usize);
         let frame = FrameView::packed(image.as_raw(), w, h).unwrap();
@@ -202,8 +207,7 @@ fn the_bounded_score_is_the_score_or_proves_it_is_under_the_bar() {
     let (mut scored, mut refused, mut silhouettes_skipped, mut cameras_skipped) = (0, 0, 0, 0);
     for (scenario, seed) in [("random-mono", 203), ("random-stereo", 204)] {
         let sequence = common::seeded(dir.path(), scenario, seed, 1);
-        let truth = sequence.read_truth().unwrap();
-        let q: Vec<f32> = truth.rows[0].iter().map(|&v| v as f32).collect();
+        let q = first_true_state(&sequence);
         let images: Vec<_> = (0..sequence.cameras.len())
             .map(|k| sequence.read_frame(k, 0).unwrap())
             .collect();
@@ -284,8 +288,7 @@ fn the_silhouette_score_is_the_plain_per_point_count() {
         ("random-mono", 205),
     ] {
         let sequence = common::seeded(dir.path(), scenario, seed, 1);
-        let truth = sequence.read_truth().unwrap();
-        let q: Vec<f32> = truth.rows[0].iter().map(|&v| v as f32).collect();
+        let q = first_true_state(&sequence);
         let image = sequence.read_frame(0, 0).unwrap();
         let (w, h) = (image.width() as usize, image.height() as usize);
         let frame = FrameView::packed(image.as_raw(), w, h).unwrap();
