@@ -51,6 +51,7 @@ use crate::frame::FrameView;
 use crate::hypotheses::{HypothesesConfig, Hypothesis, MultiReport, MultiTracker};
 use crate::likelihood::{EdgeMap, LikelihoodError};
 use crate::model::Model;
+use crate::motion::PriorWeights;
 pub use crate::status::Status;
 use crate::tracker::{FrameReport, Tracker, TrackerConfig, TrackerError};
 use crate::watch::{Watch, WatchConfig};
@@ -249,6 +250,9 @@ pub struct AutoTracker {
     /// Tracking frames left in which the search's other leaves are carried as hypotheses
     /// beside the accepted one ([`FinderConfig::confirm_frames`]).
     confirm_left: u32,
+    /// Frames left that the tracker runs without its prior on the palm's position, after an
+    /// acquisition ([`FinderConfig::settle_frames`]).
+    settle_left: u32,
     /// The best hypothesis' scores summed over the confirming frames so far, and how many.
     confirm_scores: (f32, u32),
     /// A leaf accepted on the last frame, claimed only if this frame confirms it.
@@ -288,6 +292,7 @@ impl AutoTracker {
             vouched: heapless::Vec::new(),
             hypotheses: HypothesesConfig::default(),
             confirm_left: 0,
+            settle_left: 0,
             confirm_scores: (0.0, 0),
             probation: None,
         })
@@ -415,7 +420,7 @@ impl AutoTracker {
         frames: &[FrameView<'_>],
         edge_buffers: &mut [&mut [u8]],
     ) -> Result<AutoReport, AutoError> {
-        let multi = self.multi.track(frames, edge_buffers)?;
+        let multi = self.track_hypotheses(frames, edge_buffers)?;
         let mut watch_score = None;
         if let Some(probation) = self.probation.take() {
             let confirmed = !multi.report.lost && {
@@ -587,12 +592,36 @@ impl AutoTracker {
         }
     }
 
+    /// The hypotheses tracked on a frame, without the prior on the palm's position while an
+    /// acquisition settles ([`FinderConfig::settle_frames`]).
+    fn track_hypotheses(
+        &mut self,
+        frames: &[FrameView<'_>],
+        edge_buffers: &mut [&mut [u8]],
+    ) -> Result<MultiReport, AutoError> {
+        if self.settle_left == 0 {
+            return self.multi.track(frames, edge_buffers);
+        }
+        self.settle_left -= 1;
+        let own = self.multi.tracker().config().motion.prior;
+        let settling = PriorWeights {
+            translation: 0.0,
+            ..own
+        };
+        // `own` was valid when the tracker was configured, so `settling` is too.
+        self.multi.tracker_mut().set_prior(settling);
+        let multi = self.multi.track(frames, edge_buffers);
+        self.multi.tracker_mut().set_prior(own);
+        multi
+    }
+
     /// After a leaf is accepted: when [`FinderConfig::confirm_frames`] asks, the other good
     /// leaves (`others`: the search's, or the local re-acquisition's other starts) join it as
     /// hypotheses for that many frames, so the likelihood over several frames (and each
     /// leaf's Gauss–Newton on each) chooses among them.
     fn confirm(&mut self, others: &[[f32; MAX_STATES]]) -> Result<(), AutoError> {
         let finder = *self.finder.config();
+        self.settle_left = u32::from(finder.settle_frames);
         if finder.confirm_frames == 0 || others.is_empty() {
             return Ok(());
         }

@@ -290,6 +290,17 @@ impl Tracker {
         report
     }
 
+    /// The prior toward the predicted state the frames to come are tracked under, in place
+    /// of the configured one (which [`Tracker::config`] then shows). Weights that are not
+    /// finite and non-negative are refused: `false`, and nothing changes.
+    pub fn set_prior(&mut self, prior: PriorWeights) -> bool {
+        if !prior.is_valid() {
+            return false;
+        }
+        self.config.motion.prior = prior;
+        true
+    }
+
     /// Restarts tracking from `state`, forgetting the motion so far.
     pub fn reset(&mut self, state: &[f32]) -> Result<(), TrackerError> {
         self.work

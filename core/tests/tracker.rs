@@ -223,3 +223,23 @@ fn a_leafs_refinement_keeps_the_share_of_the_prior_its_rig_is_given() {
     }
     assert_eq!(default.local_overrides(&own).prior, own.motion.prior);
 }
+
+#[test]
+fn set_prior_takes_valid_weights_and_refuses_others() {
+    use digiteyes_core::motion::PriorWeights;
+    let mut t = tracker(FreeMask::all(28)).unwrap();
+    let own = t.config().motion.prior;
+    let free_position = PriorWeights {
+        translation: 0.0,
+        ..own
+    };
+    assert!(t.set_prior(free_position));
+    assert_eq!(t.config().motion.prior, free_position);
+    for bad in [f32::NAN, -1.0, f32::INFINITY] {
+        let refused = PriorWeights { joint: bad, ..own };
+        assert!(!t.set_prior(refused), "joint weight {bad} refused");
+        assert_eq!(t.config().motion.prior, free_position, "nothing changed");
+    }
+    assert!(t.set_prior(own));
+    assert_eq!(*t.config(), TrackerConfig::default());
+}

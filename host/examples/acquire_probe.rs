@@ -169,6 +169,10 @@ struct Args {
     /// The same for the local re-acquisition's starts (default: the search's).
     #[arg(long)]
     local_prior_share: Option<f32>,
+    /// Frames the tracker runs without its prior on the palm's position after an
+    /// acquisition (default: the search's).
+    #[arg(long)]
+    settle_frames: Option<u8>,
     /// Write every refined leaf's judgement and true error here (CSV).
     #[arg(long)]
     leaves_csv: Option<std::path::PathBuf>,
@@ -289,6 +293,7 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         ],
         confirm_switch_margin: args.confirm_switch.unwrap_or(f.confirm_switch_margin),
         confirm_score_memory: args.confirm_memory.unwrap_or(f.confirm_score_memory),
+        settle_frames: args.settle_frames.unwrap_or(f.settle_frames),
     };
     (acquire, finder)
 }

@@ -5,7 +5,7 @@
 //! `palm`, `palmw`, `tipw`, `fvf`, `outer`, `knuckle` (0: no knuckle tips), `bounds` (0: the plain step); `angle` the edge-direction limit in degrees (90:
 //! off); `huber`, `tukey` the robust kernel's px; `k`, `s`, `spawn`, `smem`, `switch` the
 //! hypotheses (their count, scoring period, samples, score memory, switch margin); `csmem`,
-//! `cswitch` the confirm phase's score memory and switch margin; `watch`
+//! `cswitch` the confirm phase's score memory and switch margin; `settle` the frames without the palm's position prior after an acquisition; `watch`
 //! its period, `drop` its bar; `depth1` one camera's local depth share; `probation` the acceptance's
 //! probation drop, negative: off; `budget` the search's evaluations a frame and camera).
 //! Each group's row also gives

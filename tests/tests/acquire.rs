@@ -299,13 +299,17 @@ fn leaves_are_refined_without_the_trackers_edge_direction_test() {
     // docs/recovery.md. The seed was 817 before the lighting was varied, 803 before the
     // outermost edge, and 108 until the search's budget of 100 a frame, under which 108 is
     // acquired either way; of the even seeds 102-160, 124 is the one acquired only with the
-    // leaves' test off.) The tracker runs without its region rows here: they pull the strict
-    // leaves in as well, which hides the edge test's effect.
+    // leaves' test off.) The tracker runs without its region rows here, and without the free
+    // settling after an acquisition (`settle_frames` 0): both pull the strict leaves in as
+    // well, which hides the edge test's effect.
     let dir = tempfile::tempdir().unwrap();
     let mut tracker = TrackerConfig::default();
     tracker.fill = FillConfig::OFF;
     let angle = tracker.features.max_edge_angle_rad;
-    let finder = FinderConfig::default();
+    let finder = FinderConfig {
+        settle_frames: 0,
+        ..FinderConfig::default()
+    };
     assert!(
         angle < finder.leaf_max_edge_angle_rad,
         "the test is on by default"
@@ -318,7 +322,7 @@ fn leaves_are_refined_without_the_trackers_edge_direction_test() {
     );
     let strict = FinderConfig {
         leaf_max_edge_angle_rad: angle,
-        ..FinderConfig::default()
+        ..finder
     };
     let (good, line) = acquisition(dir.path(), "random-stereo", 124, tracker, strict);
     println!("random-stereo 124, leaves under the tracker's test: {line}");

@@ -111,6 +111,15 @@ pub struct FinderConfig {
     /// near leaves differ by less than a frame's noise on any one frame, and the one better
     /// over the confirming frames is the hand more often than the one better on the last.
     pub confirm_score_memory: f32,
+    /// After an acquisition (a leaf or a local re-acquisition's start accepted), the tracker
+    /// runs this many frames without its prior on the palm's position (default 15; 0: with
+    /// it throughout). The prior holds the palm where the start put it wherever the images
+    /// constrain it weakly, and one camera sees the hand's depth only through its size: an
+    /// accepted leaf a few per cent off in depth was held there, its fingers bent to make up
+    /// the size, instead of settling onto the hand. Afterwards the prior is back, so a long
+    /// track's depth does not wander (`docs/recovery.md`, "The palm settles freely after an
+    /// acquisition").
+    pub settle_frames: u8,
 }
 
 impl FinderConfig {
@@ -172,6 +181,7 @@ impl Default for FinderConfig {
             local_depth_share: [0.15, 0.0],
             confirm_switch_margin: 0.0,
             confirm_score_memory: 0.6,
+            settle_frames: 15,
         }
     }
 }

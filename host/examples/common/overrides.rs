@@ -27,6 +27,13 @@ pub struct TrackerOverrides {
     /// (default: the tracker's).
     #[arg(long)]
     pub bounded_step: Option<bool>,
+    /// The prior toward the predicted state: its translation weight (per mm², against px²
+    /// residuals; default: the tracker's).
+    #[arg(long)]
+    pub prior_translation: Option<f32>,
+    /// The same prior's joint weight (per rad²; default: the tracker's).
+    #[arg(long)]
+    pub prior_joint: Option<f32>,
 }
 
 impl TrackerOverrides {
@@ -40,5 +47,8 @@ impl TrackerOverrides {
         fill.full_length_widths = self.fill_full_length.unwrap_or(fill.full_length_widths);
         let estimator = &mut config.estimator;
         estimator.bounded_step = self.bounded_step.unwrap_or(estimator.bounded_step);
+        let prior = &mut config.motion.prior;
+        prior.translation = self.prior_translation.unwrap_or(prior.translation);
+        prior.joint = self.prior_joint.unwrap_or(prior.joint);
     }
 }
