@@ -479,6 +479,7 @@ impl AutoTracker {
                 self.finder.restart();
                 self.following = None;
                 self.confirm_left = 0;
+                self.settle_left = 0;
                 self.multi.set_config(self.hypotheses);
                 self.local_in_view = 0;
                 self.local_left = if self.ever_tracked {
@@ -514,6 +515,7 @@ impl AutoTracker {
         self.finder.restart();
         self.following = None;
         self.confirm_left = 0;
+        self.settle_left = 0;
         self.multi.set_config(self.hypotheses);
         self.local_left = local_left;
         self.lost_run = 0;
