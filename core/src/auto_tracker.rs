@@ -80,6 +80,11 @@ pub const LOCAL_FOLLOW_SCORE: f32 = 0.8;
 /// How far the local re-acquisition turns the last good state's palm in its variants (rad).
 pub const LOCAL_TURN_RAD: f32 = 0.3;
 
+/// [`Acquirer::variant`]'s palm moved farther from the first camera.
+const DEPTH_FARTHER: u32 = 7;
+/// [`Acquirer::variant`]'s palm moved nearer to the first camera.
+const DEPTH_NEARER: u32 = 8;
+
 /// What the tracker does once the hand has been lost for [`LOST_FRAMES_BEFORE_SEARCH`] frames.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -621,14 +626,52 @@ impl AutoTracker {
     /// leaves (`others`: the search's, or the local re-acquisition's other starts) join it as
     /// hypotheses for that many frames, so the likelihood over several frames (and each
     /// leaf's Gauss–Newton on each) chooses among them.
-    fn confirm(&mut self, others: &[[f32; MAX_STATES]]) -> Result<(), AutoError> {
+    ///
+    /// With `depth_variants` (the global search's acceptances), the accepted state moved
+    /// nearer and farther along the first camera's ray joins them
+    /// ([`FinderConfig::confirm_depth_share`]).
+    fn confirm(
+        &mut self,
+        others: &[[f32; MAX_STATES]],
+        depth_variants: bool,
+    ) -> Result<(), AutoError> {
         let finder = *self.finder.config();
         self.settle_left = u32::from(finder.settle_frames);
+        let tracker = self.multi.tracker();
+        let [shared, one_camera] = finder.confirm_depth_share;
+        let depth_share = if !depth_variants {
+            0.0
+        } else if tracker.cameras().len() >= 2 {
+            shared
+        } else {
+            one_camera
+        };
+        let mut carried: Vec<[f32; MAX_STATES], { MAX_KEEP + 2 }> = Vec::new();
+        // A share of 1 or more would put the nearer palm at or behind the camera.
+        if depth_share > 0.0 && depth_share < 1.0 {
+            let mut q = [0.0f32; MAX_STATES];
+            for (d, s) in q.iter_mut().zip(tracker.state()) {
+                *d = *s;
+            }
+            for k in [DEPTH_FARTHER, DEPTH_NEARER] {
+                let moved =
+                    self.finder
+                        .acquirer()
+                        .variant(tracker.cameras(), &q, k, 0.0, depth_share);
+                let _ = carried.push(moved);
+            }
+        }
+        let variants = carried.len() as u8;
+        for q in others {
+            let _ = carried.push(*q);
+        }
+        let others = &carried[..];
         if finder.confirm_frames == 0 || others.is_empty() {
             return Ok(());
         }
         let count = finder
             .confirm_hypotheses
+            .saturating_add(variants)
             .max(self.hypotheses.count)
             .min(MAX_HYPOTHESES as u8);
         // The leaves themselves are compared: nothing sampled around them (a confirming frame
@@ -779,7 +822,8 @@ impl AutoTracker {
             }
             self.multi.tracker_mut().restart_fresh(&q[..n])?;
             let claimed = self.found(best.worst_camera);
-            self.confirm(&others)?;
+            // Started from the last good state's depth, not one a leaf guessed.
+            self.confirm(&others, false)?;
             out.accepted = true;
             out.status = self.status();
             out.report = FrameReport {
@@ -904,7 +948,7 @@ impl AutoTracker {
                 for q in self.finder.found_leaves().iter().skip(1) {
                     let _ = others.push(*q);
                 }
-                self.confirm(&others)?;
+                self.confirm(&others, true)?;
                 out.leaf_score = Some(verdict.score);
                 out.accepted = true;
                 out.status = self.status();

@@ -173,6 +173,10 @@ struct Args {
     /// acquisition (default: the search's).
     #[arg(long)]
     settle_frames: Option<u8>,
+    /// The confirm phase's depth variants of the accepted state, as a share of its distance,
+    /// with one camera (default: the search's; two cameras keep theirs).
+    #[arg(long)]
+    confirm_depth: Option<f32>,
     /// Write every refined leaf's judgement and true error here (CSV).
     #[arg(long)]
     leaves_csv: Option<std::path::PathBuf>,
@@ -294,6 +298,10 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         confirm_switch_margin: args.confirm_switch.unwrap_or(f.confirm_switch_margin),
         confirm_score_memory: args.confirm_memory.unwrap_or(f.confirm_score_memory),
         settle_frames: args.settle_frames.unwrap_or(f.settle_frames),
+        confirm_depth_share: [
+            f.confirm_depth_share[0],
+            args.confirm_depth.unwrap_or(f.confirm_depth_share[1]),
+        ],
     };
     (acquire, finder)
 }

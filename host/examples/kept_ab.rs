@@ -1,16 +1,17 @@
 //! A/B of tracker settings on the sequences `bench robustness --keep DIR` kept: tracks every
 //! seed with each variant and prints the track-life distribution per group. A variant is
 //! `default` or `key=value` overrides joined by `+` (keys: `pj`, `pt`, `pq` the prior's
-//! weights, `sj`, `st`, `sq` the conditioning; `iters`, `predict`, `window`, `slices`,
-//! `palm`, `palmw`, `tipw`, `fvf`, `outer`, `knuckle` (0: no knuckle tips), `bounds` (0: the plain step); `angle` the edge-direction limit in degrees (90:
-//! off); `huber`, `tukey` the robust kernel's px; `k`, `s`, `spawn`, `smem`, `switch` the
-//! hypotheses (their count, scoring period, samples, score memory, switch margin); `csmem`,
-//! `cswitch` the confirm phase's score memory and switch margin; `settle` the frames without the palm's position prior after an acquisition; `watch`
-//! its period, `drop` its bar; `depth1` one camera's local depth share; `probation` the acceptance's
-//! probation drop, negative: off; `budget` the search's evaluations a frame and camera).
-//! Each group's row also gives
-//! its frames far from the hand and not flagged (`far`) and the lost flag's precision and
-//! recall (`lostP`, `lostR`), as the benchmark counts them.
+//! weights, `sj`, `st`, `sq` the conditioning; `iters`, `predict`, `window`, `slices`, `palm`,
+//! `palmw`, `tipw`, `fvf`, `outer`, `knuckle` (0: no knuckle tips), `bounds` (0: the plain
+//! step); `angle` the edge-direction limit in degrees (90: off); `huber`, `tukey` the robust
+//! kernel's px; `k`, `s`, `spawn`, `smem`, `switch` the hypotheses (their count, scoring
+//! period, samples, score memory, switch margin); `csmem`, `cswitch` the confirm phase's score
+//! memory and switch margin; `settle` the frames without the palm's position prior after an
+//! acquisition; `cdepth1` one camera's confirm-phase depth share; `watch` its period, `drop`
+//! its bar; `depth1` one camera's local depth share; `probation` the acceptance's probation
+//! drop, negative: off; `budget` the search's evaluations a frame and camera). Each group's row
+//! also gives its frames far from the hand and not flagged (`far`) and the lost flag's
+//! precision and recall (`lostP`, `lostR`), as the benchmark counts them.
 //! Every variant after the first is also compared with the first seed by seed (paired):
 //! the mean change of track life, how many seeds gained or lost more than 5 points, and the
 //! two-sided sign test's p over those (the median of 30 seeds moves by 10–20 points between

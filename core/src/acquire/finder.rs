@@ -120,6 +120,16 @@ pub struct FinderConfig {
     /// track's depth does not wander (`docs/recovery.md`, "The palm settles freely after an
     /// acquisition").
     pub settle_frames: u8,
+    /// After the global search's acceptance, the confirm phase also carries the accepted
+    /// state with its palm moved this share of its distance farther from and nearer to the
+    /// first camera, with two or more cameras (`[0]`, default 0: not carried) and with one
+    /// (`[1]`, default 0.12); a share outside (0, 1) carries none. A leaf's depth is guessed
+    /// from its size under a library finger pose, and one camera sees depth only through
+    /// that size: the variant refined over the confirming frames scores above a leaf placed
+    /// at the wrong depth. Not after a local re-acquisition, whose starts keep the depth the
+    /// track had: there a variant was taken 150 mm off and held, unflagged
+    /// (`docs/recovery.md`, "One camera's confirm phase tries the depth again").
+    pub confirm_depth_share: [f32; 2],
 }
 
 impl FinderConfig {
@@ -182,6 +192,7 @@ impl Default for FinderConfig {
             confirm_switch_margin: 0.0,
             confirm_score_memory: 0.6,
             settle_frames: 15,
+            confirm_depth_share: [0.0, 0.12],
         }
     }
 }

@@ -105,6 +105,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "csmem" => o.finder.confirm_score_memory = f,
             "cswitch" => o.finder.confirm_switch_margin = f,
             "settle" => o.finder.settle_frames = f as u8,
+            "cdepth1" => o.finder.confirm_depth_share[1] = f,
             "watch" => o.watch.every_frames = f as u8,
             "drop" => o.watch.max_drop = f,
             "depth1" => o.finder.local_depth_share[1] = f,

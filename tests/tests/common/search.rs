@@ -1,8 +1,8 @@
 //! What the search's tests set up alike: the base "from nothing" (every state free, the
 //! identity palm at the origin), an acquirer and an auto tracker on it, and edge-map buffers.
 
-use digiteyes_core::acquire::{AcquireConfig, Acquirer, WorkingVolume};
-use digiteyes_core::auto_tracker::AutoTracker;
+use digiteyes_core::acquire::{AcquireConfig, Acquirer, FinderConfig, WorkingVolume};
+use digiteyes_core::auto_tracker::{AutoTracker, Status};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
@@ -11,6 +11,16 @@ use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig};
 use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::tracker::TrackerConfig;
 use digiteyes_host::sequence::Sequence;
+
+use super::frames;
+
+/// Fingertip error (px, in these 320-wide frames) under which a frame counts as on the hand:
+/// the acquisition target's 10 px, as `acquire_probe --limit-px 20` counts it.
+pub const ON_HAND_PX: f32 = 10.0;
+/// Frames in a row on the hand that make an acquisition.
+pub const HELD_FRAMES: usize = 5;
+/// Frames the acquisition must be held within.
+pub const WITHIN_FRAMES: usize = 30;
 
 /// The state searched from: the identity palm at the origin, joints at 0.
 pub fn base(n_states: usize) -> Vec<f32> {
@@ -101,4 +111,54 @@ pub fn tip_error_px(model: &Model, cameras: &[Camera], a: &[f32], b: &[f32]) -> 
         }
     }
     sum / n as f32
+}
+
+/// `random-mono` `seed` acquired from nothing under the search's `finder`, as
+/// `acquire_probe --limit-px 20` counts it: the frame the first run of [`HELD_FRAMES`] claimed
+/// frames within [`ON_HAND_PX`] starts on (if within [`WITHIN_FRAMES`]), and every frame's tip
+/// error while claimed. Every frame also checks that the tracker's own configuration is
+/// `TrackerConfig::default()`, whatever the status machine does to it meanwhile.
+pub fn acquire_mono(seed: u64, finder: FinderConfig) -> (Option<usize>, Vec<Option<f32>>) {
+    let dir = tempfile::tempdir().unwrap();
+    let sequence = super::seeded(dir.path(), "random-mono", seed, WITHIN_FRAMES + HELD_FRAMES);
+    let truth = frames::truth_states(&sequence);
+    let (mut auto, mut bufs) = searching(&sequence, AcquireConfig::default());
+    auto.set_finder(finder);
+    let own = TrackerConfig::default();
+    let mut errors = Vec::new();
+    for (k, true_state) in truth.iter().enumerate() {
+        let images = frames::images(&sequence, k);
+        let mut b: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
+        let r = auto.step(&frames::views(&images), &mut b).unwrap();
+        assert_eq!(
+            *auto.tracker().config(),
+            own,
+            "seed {seed} frame {k}: the tracker's own configuration, prior and all"
+        );
+        let claimed = r.status != Status::Searching && !r.report.lost;
+        errors.push(
+            claimed.then(|| {
+                tip_error_px(&sequence.model, &sequence.cameras, auto.state(), true_state)
+            }),
+        );
+    }
+    let on_hand: Vec<bool> = errors
+        .iter()
+        .map(|e| e.is_some_and(|e| e < ON_HAND_PX))
+        .collect();
+    let held = (0..WITHIN_FRAMES).find(|&k| {
+        on_hand
+            .get(k..k + HELD_FRAMES)
+            .is_some_and(|run| run.iter().all(|&b| b))
+    });
+    (held, errors)
+}
+
+/// Claimed frames' tip errors (px, one decimal) and `-` for the others, for a test's log.
+pub fn format_errors(errors: &[Option<f32>]) -> String {
+    errors
+        .iter()
+        .map(|e| e.map_or("-".into(), |e| format!("{e:.1}")))
+        .collect::<Vec<_>>()
+        .join(" ")
 }

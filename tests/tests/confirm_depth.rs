@@ -1,0 +1,60 @@
+//! With one camera, the confirm phase after an acquisition also carries the accepted state
+//! with its palm moved `FinderConfig::confirm_depth_share` of its distance farther from and
+//! nearer to the camera. One camera sees the hand's depth only through its size, and a leaf
+//! placed with the wrong finger pose is placed at the wrong depth: on these mono seeds the
+//! accepted leaf's palm is 96 and 164 mm off the hand (`acquire_probe --trace`), its
+//! fingertips over 10 px (at 320 wide) off, and none of the search's other leaves is better. A depth variant, refined by
+//! Gauss–Newton over the confirming frames, scores above the accepted leaf and comes onto the
+//! hand; without the variants the same acceptance is held off it.
+
+use digiteyes_core::acquire::FinderConfig;
+
+mod common;
+use common::search::{self, acquire_mono, WITHIN_FRAMES};
+
+/// The search's defaults without the confirm phase's depth variants.
+fn without_depth_variants() -> FinderConfig {
+    FinderConfig {
+        confirm_depth_share: [0.0, 0.0],
+        ..FinderConfig::default()
+    }
+}
+
+#[test]
+fn the_confirm_phase_finds_the_depth_one_camera_misjudged() {
+    assert!(
+        FinderConfig::default().confirm_depth_share[1] > 0.0,
+        "one camera's confirm phase carries depth variants by default"
+    );
+    for seed in [4247, 4808] {
+        let (held, errors) = acquire_mono(seed, FinderConfig::default());
+        let (held_without, errors_without) = acquire_mono(seed, without_depth_variants());
+        println!(
+            "seed {seed} with the variants: {}",
+            search::format_errors(&errors)
+        );
+        println!(
+            "seed {seed} without them: {}",
+            search::format_errors(&errors_without)
+        );
+        assert!(
+            held.is_some(),
+            "seed {seed}: with the depth variants the hand is acquired within {WITHIN_FRAMES} frames"
+        );
+        assert_eq!(
+            held_without, None,
+            "seed {seed}: without them the same acceptance stays off the hand"
+        );
+        let first_claim = |e: &[Option<f32>]| e.iter().position(Option::is_some);
+        assert_eq!(
+            first_claim(&errors),
+            first_claim(&errors_without),
+            "seed {seed}: the same acceptance, on the same frame"
+        );
+        let last = |e: &[Option<f32>]| e.last().copied().flatten().expect("claimed at the end");
+        assert!(
+            last(&errors) < 0.5 * last(&errors_without),
+            "seed {seed}: the fingertips end nearer the hand by half"
+        );
+    }
+}
