@@ -27,8 +27,15 @@ fn the_confirm_phase_finds_the_depth_one_camera_misjudged() {
         "one camera's confirm phase carries depth variants by default"
     );
     for seed in [4247, 4808] {
-        let (held, errors) = acquire_mono(seed, FinderConfig::default());
-        let (held_without, errors_without) = acquire_mono(seed, without_depth_variants());
+        let with = acquire_mono(seed, FinderConfig::default());
+        let without = acquire_mono(seed, without_depth_variants());
+        assert_eq!(
+            with.most_hypotheses,
+            without.most_hypotheses + 2,
+            "seed {seed}: the two depth variants carried while confirming"
+        );
+        let (held, errors) = (with.held, with.errors);
+        let (held_without, errors_without) = (without.held, without.errors);
         println!(
             "seed {seed} with the variants: {}",
             search::format_errors(&errors)
@@ -55,6 +62,27 @@ fn the_confirm_phase_finds_the_depth_one_camera_misjudged() {
         assert!(
             last(&errors) < 0.5 * last(&errors_without),
             "seed {seed}: the fingertips end nearer the hand by half"
+        );
+    }
+}
+
+#[test]
+fn a_depth_share_outside_zero_to_one_carries_no_variant() {
+    let without = acquire_mono(4247, without_depth_variants());
+    for share in [1.0, 1.5, -0.12, f32::NAN, f32::INFINITY] {
+        let finder = FinderConfig {
+            confirm_depth_share: [share, share],
+            ..FinderConfig::default()
+        };
+        let at = acquire_mono(4247, finder);
+        assert_eq!(
+            at.most_hypotheses, without.most_hypotheses,
+            "share {share}: no variant carried"
+        );
+        assert_eq!(at.held, without.held, "share {share}: the same acquisition");
+        assert_eq!(
+            at.errors, without.errors,
+            "share {share}: every frame as without the variants, bit for bit"
         );
     }
 }

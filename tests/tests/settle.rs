@@ -24,8 +24,10 @@ fn settling(settle_frames: u8) -> FinderConfig {
 #[test]
 fn an_acquisition_settles_onto_the_hand_without_the_position_prior() {
     for seed in [4308, 4479] {
-        let (held, errors) = acquire_mono(seed, settling(FinderConfig::default().settle_frames));
-        let (held_with_prior, errors_with_prior) = acquire_mono(seed, settling(0));
+        let settled = acquire_mono(seed, settling(FinderConfig::default().settle_frames));
+        let (held, errors) = (settled.held, settled.errors);
+        let with_prior = acquire_mono(seed, settling(0));
+        let (held_with_prior, errors_with_prior) = (with_prior.held, with_prior.errors);
         println!("seed {seed} settling: {}", search::format_errors(&errors));
         println!(
             "seed {seed} with the prior: {}",

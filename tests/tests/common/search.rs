@@ -113,12 +113,22 @@ pub fn tip_error_px(model: &Model, cameras: &[Camera], a: &[f32], b: &[f32]) -> 
     sum / n as f32
 }
 
+/// What [`acquire_mono`] saw.
+pub struct MonoRun {
+    /// The frame the first run of [`HELD_FRAMES`] claimed frames within [`ON_HAND_PX`]
+    /// starts on, if within [`WITHIN_FRAMES`].
+    pub held: Option<usize>,
+    /// Every frame's tip error (px) while claimed.
+    pub errors: Vec<Option<f32>>,
+    /// The most hypotheses carried on any frame.
+    pub most_hypotheses: usize,
+}
+
 /// `random-mono` `seed` acquired from nothing under the search's `finder`, as
-/// `acquire_probe --limit-px 20` counts it: the frame the first run of [`HELD_FRAMES`] claimed
-/// frames within [`ON_HAND_PX`] starts on (if within [`WITHIN_FRAMES`]), and every frame's tip
-/// error while claimed. Every frame also checks that the tracker's own configuration is
-/// `TrackerConfig::default()`, whatever the status machine does to it meanwhile.
-pub fn acquire_mono(seed: u64, finder: FinderConfig) -> (Option<usize>, Vec<Option<f32>>) {
+/// `acquire_probe --limit-px 20` counts it. Every frame also checks that the tracker's own
+/// configuration is `TrackerConfig::default()`, whatever the status machine does to it
+/// meanwhile.
+pub fn acquire_mono(seed: u64, finder: FinderConfig) -> MonoRun {
     let dir = tempfile::tempdir().unwrap();
     let sequence = super::seeded(dir.path(), "random-mono", seed, WITHIN_FRAMES + HELD_FRAMES);
     let truth = frames::truth_states(&sequence);
@@ -126,6 +136,7 @@ pub fn acquire_mono(seed: u64, finder: FinderConfig) -> (Option<usize>, Vec<Opti
     auto.set_finder(finder);
     let own = TrackerConfig::default();
     let mut errors = Vec::new();
+    let mut most_hypotheses = 0;
     for (k, true_state) in truth.iter().enumerate() {
         let images = frames::images(&sequence, k);
         let mut b: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
@@ -135,6 +146,7 @@ pub fn acquire_mono(seed: u64, finder: FinderConfig) -> (Option<usize>, Vec<Opti
             own,
             "seed {seed} frame {k}: the tracker's own configuration, prior and all"
         );
+        most_hypotheses = most_hypotheses.max(auto.hypotheses().len());
         let claimed = r.status != Status::Searching && !r.report.lost;
         errors.push(
             claimed.then(|| {
@@ -151,7 +163,11 @@ pub fn acquire_mono(seed: u64, finder: FinderConfig) -> (Option<usize>, Vec<Opti
             .get(k..k + HELD_FRAMES)
             .is_some_and(|run| run.iter().all(|&b| b))
     });
-    (held, errors)
+    MonoRun {
+        held,
+        errors,
+        most_hypotheses,
+    }
 }
 
 /// Claimed frames' tip errors (px, one decimal) and `-` for the others, for a test's log.
