@@ -7,11 +7,11 @@
 //! kernel's px; `k`, `s`, `spawn`, `smem`, `switch` the hypotheses (their count, scoring
 //! period, samples, score memory, switch margin); `csmem`, `cswitch` the confirm phase's score
 //! memory and switch margin; `settle` the frames without the palm's position prior after an
-//! acquisition; `cdepth1` one camera's confirm-phase depth share; `watch` its period, `drop`
-//! its bar; `depth1` one camera's local depth share; `probation` the acceptance's probation
-//! drop, negative: off; `budget` the search's evaluations a frame and camera). Each group's row
-//! also gives its frames far from the hand and not flagged (`far`) and the lost flag's
-//! precision and recall (`lostP`, `lostR`), as the benchmark counts them.
+//! acquisition; `cdepth1` one camera's confirm-phase depth share; `cframes` its frames; `watch`
+//! its period, `drop` its bar; `depth1` one camera's local depth share; `probation` the
+//! acceptance's probation drop, negative: off; `budget` the search's evaluations a frame and
+//! camera). Each group's row also gives its frames far from the hand and not flagged (`far`)
+//! and the lost flag's precision and recall (`lostP`, `lostR`), as the benchmark counts them.
 //! Every variant after the first is also compared with the first seed by seed (paired):
 //! the mean change of track life, how many seeds gained or lost more than 5 points, and the
 //! two-sided sign test's p over those (the median of 30 seeds moves by 10–20 points between

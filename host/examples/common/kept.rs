@@ -106,6 +106,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "cswitch" => o.finder.confirm_switch_margin = f,
             "settle" => o.finder.settle_frames = f as u8,
             "cdepth1" => o.finder.confirm_depth_share[1] = f,
+            "cframes" => o.finder.confirm_frames = f as u8,
             "watch" => o.watch.every_frames = f as u8,
             "drop" => o.watch.max_drop = f,
             "depth1" => o.finder.local_depth_share[1] = f,
