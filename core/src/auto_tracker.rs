@@ -42,7 +42,7 @@ use heapless::Vec;
 
 use crate::acquire::{
     AcceptConfig, AcquireConfig, Acquirer, Finder, FinderConfig, FinderStep, WorkingVolume,
-    LOCAL_VARIANTS, MAX_KEEP,
+    DEPTH_VARIANTS, LOCAL_VARIANTS, MAX_KEEP,
 };
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_HYPOTHESES, MAX_STATES};
@@ -638,26 +638,23 @@ impl AutoTracker {
         let finder = *self.finder.config();
         self.settle_left = u32::from(finder.settle_frames);
         let tracker = self.multi.tracker();
-        let [shared, one_camera] = finder.confirm_depth_share;
-        let depth_share = if !depth_variants {
-            0.0
-        } else if tracker.cameras().len() >= 2 {
-            shared
+        let depth_share = if depth_variants {
+            finder.confirm_depth(tracker.cameras().len())
         } else {
-            one_camera
+            None
         };
-        let mut carried: Vec<[f32; MAX_STATES], { MAX_KEEP + 2 }> = Vec::new();
-        // A share of 1 or more would put the nearer palm at or behind the camera.
-        if depth_share > 0.0 && depth_share < 1.0 {
+        let mut carried: Vec<[f32; MAX_STATES], { MAX_KEEP + DEPTH_VARIANTS as usize }> =
+            Vec::new();
+        if let Some(share) = depth_share {
             let mut q = [0.0f32; MAX_STATES];
             for (d, s) in q.iter_mut().zip(tracker.state()) {
                 *d = *s;
             }
             for k in [DEPTH_FARTHER, DEPTH_NEARER] {
-                let moved =
-                    self.finder
-                        .acquirer()
-                        .variant(tracker.cameras(), &q, k, 0.0, depth_share);
+                let moved = self
+                    .finder
+                    .acquirer()
+                    .variant(tracker.cameras(), &q, k, 0.0, share);
                 let _ = carried.push(moved);
             }
         }

@@ -230,8 +230,9 @@ fn searching_frames_carry_no_hypotheses() {
             rows.len()
         );
         // Up to K, or for the few frames that confirm an acquisition, up to the search's
-        // confirming count (its other good leaves carried beside the accepted one).
-        let confirming = usize::from(FinderConfig::default().confirm_hypotheses);
+        // confirming count (its other good leaves carried beside the accepted one, and one
+        // camera's two depth variants).
+        let confirming = usize::from(FinderConfig::default().confirm_capacity(1));
         assert!(
             rows.len() <= confirming.max(2),
             "frame {k}: {} rows",

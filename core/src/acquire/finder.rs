@@ -133,6 +133,27 @@ pub struct FinderConfig {
 }
 
 impl FinderConfig {
+    /// The share of the palm's distance that the confirm phase's depth variants move it, with
+    /// `n_cameras` cameras ([`FinderConfig::confirm_depth_share`]); `None` when none are
+    /// carried (a share outside (0, 1): 1 or more would put the nearer palm at or behind the
+    /// camera).
+    pub fn confirm_depth(&self, n_cameras: usize) -> Option<f32> {
+        let share = self.confirm_depth_share[usize::from(n_cameras < 2)];
+        (share > 0.0 && share < 1.0).then_some(share)
+    }
+
+    /// Hypotheses the confirm phase may carry after the global search's acceptance with
+    /// `n_cameras` cameras: [`FinderConfig::confirm_hypotheses`], and the two depth variants
+    /// when they are carried.
+    pub fn confirm_capacity(&self, n_cameras: usize) -> u8 {
+        let variants = if self.confirm_depth(n_cameras).is_some() {
+            DEPTH_VARIANTS
+        } else {
+            0
+        };
+        self.confirm_hypotheses.saturating_add(variants)
+    }
+
     /// What a leaf's refinement runs the tracker under, from the tracker's own `config` and
     /// cameras: this search's robust weight, edge test and step, and
     /// [`FinderConfig::leaf_prior_share`] of its prior.
@@ -196,6 +217,10 @@ impl Default for FinderConfig {
         }
     }
 }
+
+/// Depth variants the confirm phase carries, when it carries them: the palm farther and
+/// nearer.
+pub const DEPTH_VARIANTS: u8 = 2;
 
 /// What one searching frame did.
 #[derive(Debug, Clone, Copy, PartialEq)]
