@@ -30,7 +30,15 @@ fn each_rig_takes_its_own_share() {
 
 #[test]
 fn a_share_outside_zero_to_one_carries_no_variant() {
-    for share in [0.0, -0.1, 1.0, 1.5, f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+    for share in [
+        0.0,
+        -0.1,
+        1.0,
+        1.5,
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+    ] {
         let f = with_shares(share, share);
         for n in [1, 2] {
             assert_eq!(f.confirm_depth(n), None, "share {share}, {n} cameras");
