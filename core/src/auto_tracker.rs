@@ -658,7 +658,6 @@ impl AutoTracker {
                 let _ = carried.push(moved);
             }
         }
-        let variants = carried.len() as u8;
         for q in others {
             let _ = carried.push(*q);
         }
@@ -666,9 +665,12 @@ impl AutoTracker {
         if finder.confirm_frames == 0 || others.is_empty() {
             return Ok(());
         }
-        let count = finder
-            .confirm_hypotheses
-            .saturating_add(variants)
+        let capacity = if depth_share.is_some() {
+            finder.confirm_capacity(tracker.cameras().len())
+        } else {
+            finder.confirm_hypotheses
+        };
+        let count = capacity
             .max(self.hypotheses.count)
             .min(MAX_HYPOTHESES as u8);
         // The leaves themselves are compared: nothing sampled around them (a confirming frame

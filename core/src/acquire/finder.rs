@@ -127,7 +127,7 @@ pub struct FinderConfig {
     /// from its size under a library finger pose, and one camera sees depth only through
     /// that size: the variant refined over the confirming frames scores above a leaf placed
     /// at the wrong depth. Not after a local re-acquisition, whose starts keep the depth the
-    /// track had: there a variant was taken 150 mm off and held, unflagged
+    /// track had: there a variant was taken 80–95 mm off and held, unflagged
     /// (`docs/recovery.md`, "One camera's confirm phase tries the depth again").
     pub confirm_depth_share: [f32; 2],
 }
