@@ -260,6 +260,9 @@ pub struct AutoTracker {
     settle_left: u32,
     /// The best hypothesis' scores summed over the confirming frames so far, and how many.
     confirm_scores: (f32, u32),
+    /// Confirm phases still to end in a polish of the fingers
+    /// ([`FinderConfig::polish_margin`]).
+    polish_left: u8,
     /// A leaf accepted on the last frame, claimed only if this frame confirms it.
     probation: Option<Probation>,
 }
@@ -299,6 +302,7 @@ impl AutoTracker {
             confirm_left: 0,
             settle_left: 0,
             confirm_scores: (0.0, 0),
+            polish_left: 0,
             probation: None,
         })
     }
@@ -453,6 +457,10 @@ impl AutoTracker {
                 self.multi.set_config(self.hypotheses);
                 let (sum, n) = self.confirm_scores;
                 refuted = sum / (n.max(1) as f32) < self.finder.config().confirm_min_score;
+                if !refuted && !multi.report.lost && self.polish_left > 0 {
+                    self.polish_left -= 1;
+                    self.polish(frames, edge_buffers)?;
+                }
             }
         }
         let mut report = multi.report;
@@ -485,6 +493,7 @@ impl AutoTracker {
                 self.following = None;
                 self.confirm_left = 0;
                 self.settle_left = 0;
+                self.polish_left = 0;
                 self.multi.set_config(self.hypotheses);
                 self.local_in_view = 0;
                 self.local_left = if self.ever_tracked {
@@ -521,6 +530,7 @@ impl AutoTracker {
         self.following = None;
         self.confirm_left = 0;
         self.settle_left = 0;
+        self.polish_left = 0;
         self.multi.set_config(self.hypotheses);
         self.local_left = local_left;
         self.lost_run = 0;
@@ -580,6 +590,7 @@ impl AutoTracker {
     fn found(&mut self, worst_camera: f32) -> bool {
         let local_left = self.local_left;
         self.confirm_left = 0;
+        self.polish_left = 0;
         self.multi.set_config(self.hypotheses);
         self.multi.adopt();
         self.watch.clear();
@@ -637,6 +648,62 @@ impl AutoTracker {
     ) -> Result<(), AutoError> {
         let finder = *self.finder.config();
         self.settle_left = u32::from(finder.settle_frames);
+        self.polish_left = u8::from(
+            finder
+                .polish(self.multi.tracker().cameras().len())
+                .is_some(),
+        );
+        self.carry(others, depth_variants)
+    }
+
+    /// The confirm phase has ended: its best, each finger given the library's best-scoring
+    /// pose, joins it for another confirm phase when that scores more by
+    /// [`FinderConfig::polish_margin`].
+    fn polish(
+        &mut self,
+        frames: &[FrameView<'_>],
+        edge_buffers: &mut [&mut [u8]],
+    ) -> Result<(), AutoError> {
+        let n_cameras = self.multi.tracker().cameras().len();
+        let Some(margin) = self.finder.config().polish(n_cameras) else {
+            return Ok(());
+        };
+        let likelihood = self.finder.acquirer().config().likelihood;
+        let mut maps: Vec<EdgeMap<'_>, MAX_CAMERAS> = Vec::new();
+        for (buffer, frame) in edge_buffers.iter_mut().zip(frames) {
+            let map = EdgeMap::build(buffer, frame, &likelihood).map_err(AutoError::EdgeMap)?;
+            if maps.push(map).is_err() {
+                return Err(AutoError::Tracker(TrackerError::CameraCount));
+            }
+        }
+        let mut q = [0.0f32; MAX_STATES];
+        let tracker = self.multi.tracker();
+        for (d, s) in q.iter_mut().zip(tracker.state()) {
+            *d = *s;
+        }
+        let (polished, score, before) = self.finder.acquirer_mut().polish_fingers(
+            tracker.model(),
+            tracker.cameras(),
+            frames,
+            &maps,
+            &q,
+        );
+        if score > before + margin {
+            self.carry(&[polished], false)?;
+        }
+        Ok(())
+    }
+
+    /// Carries `others` beside the tracker's present state as hypotheses for
+    /// [`FinderConfig::confirm_frames`] frames; with `depth_variants`, the present state moved
+    /// nearer and farther along the first camera's ray first
+    /// ([`FinderConfig::confirm_depth_share`]).
+    fn carry(
+        &mut self,
+        others: &[[f32; MAX_STATES]],
+        depth_variants: bool,
+    ) -> Result<(), AutoError> {
+        let finder = *self.finder.config();
         let tracker = self.multi.tracker();
         let depth_share = if depth_variants {
             finder.confirm_depth(tracker.cameras().len())

@@ -177,6 +177,11 @@ struct Args {
     /// with one camera (default: the search's; two cameras keep theirs).
     #[arg(long)]
     confirm_depth: Option<f32>,
+    /// The margin a confirm phase's best with each finger polished must score by to be
+    /// carried for another phase: two cameras, one camera (`A,B`; negative: never; default:
+    /// the search's).
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    polish_margin: Option<Vec<f32>>,
     /// Write every refined leaf's judgement and true error here (CSV).
     #[arg(long)]
     leaves_csv: Option<std::path::PathBuf>,
@@ -302,6 +307,10 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             f.confirm_depth_share[0],
             args.confirm_depth.unwrap_or(f.confirm_depth_share[1]),
         ],
+        polish_margin: match args.polish_margin.as_deref() {
+            Some([two, one]) => [*two, *one],
+            _ => f.polish_margin,
+        },
     };
     (acquire, finder)
 }

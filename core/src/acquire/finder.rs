@@ -130,6 +130,17 @@ pub struct FinderConfig {
     /// track had: there a variant was taken 80–95 mm off and held, unflagged
     /// (`docs/recovery.md`, "One camera's confirm phase tries the depth again").
     pub confirm_depth_share: [f32; 2],
+    /// When a confirm phase ends, each finger of its best is given the library's pose that
+    /// scores best on the frame ([`Acquirer::polish_fingers`](super::Acquirer::polish_fingers));
+    /// when that raises the score by more than this, with two or more cameras (`[0]`) and
+    /// with one (`[1]`), the polished state is carried beside the best for another
+    /// [`FinderConfig::confirm_frames`] frames (negative or NaN: never polished). Default 0
+    /// with two cameras, off with one: two cameras' re-acquisitions after a blackout are
+    /// held off the hand with the palm right and a finger or two wrong, and polished they
+    /// came back more often (288 of 323 seeds against 281); one camera's likelihood cannot
+    /// tell a polished finger from a wrong one (mono acquisition 463 of 600 either way;
+    /// `docs/recovery.md`, "The fingers polished after a confirm phase").
+    pub polish_margin: [f32; 2],
 }
 
 impl FinderConfig {
@@ -152,6 +163,13 @@ impl FinderConfig {
             0
         };
         self.confirm_hypotheses.saturating_add(variants)
+    }
+
+    /// How much [`FinderConfig::polish_margin`] asks of a polished state with `n_cameras`
+    /// cameras; `None`: not polished.
+    pub fn polish(&self, n_cameras: usize) -> Option<f32> {
+        let margin = self.polish_margin[usize::from(n_cameras < 2)];
+        (margin >= 0.0).then_some(margin)
     }
 
     /// What a leaf's refinement runs the tracker under, from the tracker's own `config` and
@@ -214,6 +232,7 @@ impl Default for FinderConfig {
             confirm_score_memory: 0.6,
             settle_frames: 15,
             confirm_depth_share: [0.0, 0.12],
+            polish_margin: [0.0, -1.0],
         }
     }
 }

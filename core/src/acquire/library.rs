@@ -75,6 +75,33 @@ pub(crate) const fn finger_start(f: usize) -> usize {
     7 + 4 * f
 }
 
+/// Fingers the library poses: fingers 1–4 and the thumb.
+pub const FINGERS: usize = 5;
+
+/// Sets the free states of finger `finger` (0..4: fingers 1–4; 4: the thumb) of `q` (the
+/// first `n_states`) to their values in library pose `pose`; the other fingers kept.
+pub(crate) fn set_finger(
+    q: &mut [f32; MAX_STATES],
+    pose: usize,
+    finger: usize,
+    n_states: usize,
+    free: FreeMask,
+) {
+    let values: &[f32] = match (FINGER_POSES.get(pose), THUMB_POSES.get(pose)) {
+        (Some(fingers), _) if finger < 4 => &fingers[finger],
+        (_, Some(thumb)) if finger == 4 => thumb,
+        _ => return,
+    };
+    for (k, v) in values.iter().enumerate() {
+        let s = finger_start(finger) + k;
+        if s < n_states && free.contains(s) {
+            if let Some(d) = q.get_mut(s) {
+                *d = *v;
+            }
+        }
+    }
+}
+
 /// Sets the free finger states of `q` (the first `n_states`) to library pose `pose`.
 pub(crate) fn set_fingers(q: &mut [f32; MAX_STATES], pose: usize, n_states: usize, free: FreeMask) {
     let Some(fingers) = FINGER_POSES.get(pose) else {

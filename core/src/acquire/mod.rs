@@ -44,7 +44,7 @@ pub use library::{FingerPose, POSE_COUNT};
 pub use place::{triangulate, Depth};
 pub use volume::WorkingVolume;
 
-use library::{finger_start, set_fingers};
+use library::{finger_start, set_finger, set_fingers, FINGERS};
 use place::Scratch;
 use rotation::{axis_angle, coarse_rotation, compose};
 
@@ -466,6 +466,40 @@ impl Acquirer {
             }
         }
         best
+    }
+
+    /// `q` with each finger in turn (fingers 1–4, then the thumb) given the pose of the
+    /// library's that scores best on this frame with the other fingers as they are, when one
+    /// scores more than the finger as it is; its palm kept. Returns the new state, its mean
+    /// score over the cameras and `q`'s: `POSE_COUNT` × 5 + 1 evaluations in every camera.
+    /// A track that holds the palm and has a finger or two wrong is a local minimum of
+    /// Gauss–Newton, not of the likelihood.
+    pub fn polish_fingers(
+        &mut self,
+        model: &Model,
+        cameras: &[Camera],
+        frames: &[FrameView<'_>],
+        edges: &[EdgeMap<'_>],
+        q: &[f32; MAX_STATES],
+    ) -> ([f32; MAX_STATES], f32, f32) {
+        let start = self.score(model, cameras, frames, edges, q);
+        let mut best = (*q, start);
+        for finger in 0..FINGERS {
+            let mut kept = best;
+            for pose in 0..POSE_COUNT {
+                let mut posed = best.0;
+                set_finger(&mut posed, pose, finger, self.n_states, self.free);
+                if posed == best.0 {
+                    continue;
+                }
+                let score = self.score(model, cameras, frames, edges, &posed);
+                if score > kept.1 {
+                    kept = (posed, score);
+                }
+            }
+            best = kept;
+        }
+        (best.0, best.1, start)
     }
 
     /// Moves the palm of `q` onto this frame's bright regions (`edges`' regions), its depth

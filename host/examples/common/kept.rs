@@ -107,6 +107,8 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "settle" => o.finder.settle_frames = f as u8,
             "cdepth1" => o.finder.confirm_depth_share[1] = f,
             "cframes" => o.finder.confirm_frames = f as u8,
+            "polish1" => o.finder.polish_margin[1] = f,
+            "polish2" => o.finder.polish_margin[0] = f,
             "watch" => o.watch.every_frames = f as u8,
             "drop" => o.watch.max_drop = f,
             "depth1" => o.finder.local_depth_share[1] = f,
