@@ -49,7 +49,7 @@ use crate::config::{MAX_CAMERAS, MAX_HYPOTHESES, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
 use crate::hypotheses::{HypothesesConfig, Hypothesis, MultiReport, MultiTracker};
-use crate::likelihood::{EdgeMap, LikelihoodError};
+use crate::likelihood::{EdgeMap, LikelihoodConfig, LikelihoodError};
 use crate::model::Model;
 use crate::motion::PriorWeights;
 pub use crate::status::Status;
@@ -223,6 +223,25 @@ fn largest_frame_pixels(cameras: &[Camera]) -> usize {
         .map(|c| c.width as usize * c.height as usize)
         .max()
         .unwrap_or(0)
+}
+
+/// One edge map per camera: `frames[i]`'s, built into `edge_buffers[i]`.
+fn edge_maps<'b>(
+    edge_buffers: &'b mut [&mut [u8]],
+    frames: &[FrameView<'_>],
+    likelihood: &LikelihoodConfig,
+) -> Result<Vec<EdgeMap<'b>, MAX_CAMERAS>, AutoError> {
+    if edge_buffers.len() < frames.len() {
+        return Err(AutoError::BufferCount);
+    }
+    let mut maps = Vec::new();
+    for (buffer, frame) in edge_buffers.iter_mut().zip(frames) {
+        let map = EdgeMap::build(buffer, frame, likelihood).map_err(AutoError::EdgeMap)?;
+        if maps.push(map).is_err() {
+            return Err(AutoError::Tracker(TrackerError::CameraCount));
+        }
+    }
+    Ok(maps)
 }
 
 /// A tracker that finds the hand, tracks it, and finds it again.
@@ -549,17 +568,8 @@ impl AutoTracker {
         frames: &[FrameView<'_>],
         edge_buffers: &mut [&mut [u8]],
     ) -> Result<f32, AutoError> {
-        if edge_buffers.len() < frames.len() {
-            return Err(AutoError::BufferCount);
-        }
         let likelihood = self.finder.acquirer().config().likelihood;
-        let mut maps: Vec<EdgeMap<'_>, MAX_CAMERAS> = Vec::new();
-        for (buffer, frame) in edge_buffers.iter_mut().zip(frames) {
-            let map = EdgeMap::build(buffer, frame, &likelihood).map_err(AutoError::EdgeMap)?;
-            if maps.push(map).is_err() {
-                return Err(AutoError::Tracker(TrackerError::CameraCount));
-            }
-        }
+        let maps = edge_maps(edge_buffers, frames, &likelihood)?;
         let mut q = [0.0f32; MAX_STATES];
         let tracker = self.multi.tracker();
         for (d, s) in q.iter_mut().zip(tracker.state()) {
@@ -669,13 +679,7 @@ impl AutoTracker {
             return Ok(());
         };
         let likelihood = self.finder.acquirer().config().likelihood;
-        let mut maps: Vec<EdgeMap<'_>, MAX_CAMERAS> = Vec::new();
-        for (buffer, frame) in edge_buffers.iter_mut().zip(frames) {
-            let map = EdgeMap::build(buffer, frame, &likelihood).map_err(AutoError::EdgeMap)?;
-            if maps.push(map).is_err() {
-                return Err(AutoError::Tracker(TrackerError::CameraCount));
-            }
-        }
+        let maps = edge_maps(edge_buffers, frames, &likelihood)?;
         let mut q = [0.0f32; MAX_STATES];
         let tracker = self.multi.tracker();
         for (d, s) in q.iter_mut().zip(tracker.state()) {
@@ -974,18 +978,8 @@ impl AutoTracker {
         if frames.len() != self.multi.tracker().cameras().len() {
             return Err(AutoError::Tracker(TrackerError::FrameCount));
         }
-        if edge_buffers.len() < frames.len() {
-            return Err(AutoError::BufferCount);
-        }
         let config = *self.finder.acquirer().config();
-        let mut maps: Vec<EdgeMap<'_>, MAX_CAMERAS> = Vec::new();
-        for (buffer, frame) in edge_buffers.iter_mut().zip(frames) {
-            let map =
-                EdgeMap::build(buffer, frame, &config.likelihood).map_err(AutoError::EdgeMap)?;
-            if maps.push(map).is_err() {
-                return Err(AutoError::Tracker(TrackerError::CameraCount));
-            }
-        }
+        let maps = edge_maps(edge_buffers, frames, &config.likelihood)?;
         let mut out = AutoReport {
             status: Status::Searching,
             report: FrameReport {

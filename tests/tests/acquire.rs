@@ -17,6 +17,7 @@ use digiteyes_host::sequence::Sequence;
 use digiteyes_host::TrackerConfig;
 
 mod common;
+use common::search::TrueFrame;
 use common::{frames, search};
 use digiteyes_host::render::hand_free::hand_free;
 
@@ -341,49 +342,45 @@ fn the_library_pose_that_scores_best_is_the_nearest_the_hand() {
     // the nearest: the likelihood scores the open hand 0.909 here, the relaxed one, nearest
     // the truth, 0.877; the fist and the pointing hand score lowest. Gauss-Newton refines
     // the chosen start before the acceptance judges it.)
-    let dir = tempfile::tempdir().unwrap();
-    let sequence = common::seeded(dir.path(), "fullhand-stereo", 0, 1);
-    let n = sequence.n_states();
-    let truth: Vec<f32> = sequence.read_truth().unwrap().rows[0]
-        .iter()
-        .map(|&v| v as f32)
-        .collect();
-    let acquire = AcquireConfig::default();
-    let mut acquirer = search::acquirer(&sequence, acquire);
-    let images = frames::images(&sequence, 0);
-    let views = frames::views(&images);
-    let mut bufs = search::buffers(&sequence.cameras, acquire.likelihood.stride_px);
-    let maps = search::edge_maps(&mut bufs, &views, &acquire.likelihood);
-    let mut q = [0.0f32; MAX_STATES];
-    q[..n].copy_from_slice(&truth);
-    let fist = acquirer.with_pose(&q, FingerPose::Fist as usize);
-    let (chosen, score) =
-        acquirer.best_pose(&sequence.model, &sequence.cameras, &views, &maps, &fist);
-    assert_eq!(chosen[..7], truth[..7], "the palm is kept");
-    let distance = |p: &[f32; MAX_STATES]| -> f32 {
-        (7..n)
-            .map(|i| (p[i] - truth[i]).powi(2))
-            .sum::<f32>()
-            .sqrt()
-    };
-    let poses: Vec<[f32; MAX_STATES]> =
-        (0..POSE_COUNT).map(|p| acquirer.with_pose(&q, p)).collect();
-    for (p, posed) in poses.iter().enumerate() {
-        let s = acquirer.score(&sequence.model, &sequence.cameras, &views, &maps, posed);
-        println!(
-            "pose {p}: {:.2} rad from the fingers, score {s:.3}",
-            distance(posed)
+    search::on_the_true_first_frame(|f| {
+        let TrueFrame {
+            sequence,
+            truth,
+            mut acquirer,
+            views,
+            maps,
+        } = f;
+        let (model, cameras) = (&sequence.model, &sequence.cameras);
+        let n = sequence.n_states();
+        let fist = acquirer.with_pose(&truth, FingerPose::Fist as usize);
+        let (chosen, score) = acquirer.best_pose(model, cameras, views, maps, &fist);
+        assert_eq!(chosen[..7], truth[..7], "the palm is kept");
+        let distance = |p: &[f32; MAX_STATES]| -> f32 {
+            (7..n)
+                .map(|i| (p[i] - truth[i]).powi(2))
+                .sum::<f32>()
+                .sqrt()
+        };
+        let poses: Vec<[f32; MAX_STATES]> = (0..POSE_COUNT)
+            .map(|p| acquirer.with_pose(&truth, p))
+            .collect();
+        for (p, posed) in poses.iter().enumerate() {
+            let s = acquirer.score(model, cameras, views, maps, posed);
+            println!(
+                "pose {p}: {:.2} rad from the fingers, score {s:.3}",
+                distance(posed)
+            );
+            assert!(s <= score, "pose {p} scores {s} over the chosen {score}");
+        }
+        let mut distances: Vec<f32> = poses.iter().map(&distance).collect();
+        distances.sort_by(f32::total_cmp);
+        let median = distances[POSE_COUNT / 2];
+        assert!(
+            distance(&chosen) < median && distance(&chosen) < distance(&fist),
+            "chose a pose {:.2} rad from the fingers; the library's median is {median:.2}, the \
+             fist {:.2}",
+            distance(&chosen),
+            distance(&fist)
         );
-        assert!(s <= score, "pose {p} scores {s} over the chosen {score}");
-    }
-    let mut distances: Vec<f32> = poses.iter().map(&distance).collect();
-    distances.sort_by(f32::total_cmp);
-    let median = distances[POSE_COUNT / 2];
-    assert!(
-        distance(&chosen) < median && distance(&chosen) < distance(&fist),
-        "chose a pose {:.2} rad from the fingers; the library's median is {median:.2}, the \
-         fist {:.2}",
-        distance(&chosen),
-        distance(&fist)
-    );
+    });
 }

@@ -4,6 +4,7 @@
 use digiteyes_core::acquire::{AcquireConfig, Acquirer, FinderConfig, WorkingVolume};
 use digiteyes_core::auto_tracker::{AutoTracker, Status};
 use digiteyes_core::camera::Camera;
+use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
@@ -177,4 +178,40 @@ pub fn format_errors(errors: &[Option<f32>]) -> String {
         .map(|e| e.map_or("-".into(), |e| format!("{e:.1}")))
         .collect::<Vec<_>>()
         .join(" ")
+}
+
+/// What a test of the library's finger poses needs on `fullhand-stereo`'s first frame (a
+/// relaxed, slightly spread hand): the sequence, its true state (every model state), an
+/// acquirer with the default search, and the frame's views and edge maps.
+pub struct TrueFrame<'a> {
+    pub sequence: &'a Sequence,
+    pub truth: [f32; MAX_STATES],
+    pub acquirer: Acquirer,
+    pub views: &'a [FrameView<'a>],
+    pub maps: &'a [EdgeMap<'a>],
+}
+
+/// Runs `test` on [`TrueFrame`].
+pub fn on_the_true_first_frame(test: impl FnOnce(TrueFrame<'_>)) {
+    let dir = tempfile::tempdir().unwrap();
+    let sequence = super::seeded(dir.path(), "fullhand-stereo", 0, 1);
+    let mut truth = [0.0f32; MAX_STATES];
+    for (t, v) in truth
+        .iter_mut()
+        .zip(&sequence.read_truth().unwrap().rows[0])
+    {
+        *t = *v as f32;
+    }
+    let acquire = AcquireConfig::default();
+    let images = frames::images(&sequence, 0);
+    let views = frames::views(&images);
+    let mut bufs = buffers(&sequence.cameras, acquire.likelihood.stride_px);
+    let maps = edge_maps(&mut bufs, &views, &acquire.likelihood);
+    test(TrueFrame {
+        sequence: &sequence,
+        truth,
+        acquirer: acquirer(&sequence, acquire),
+        views: &views,
+        maps: &maps,
+    });
 }
