@@ -217,10 +217,13 @@ fn an_accepted_leaf_is_confirmed_among_the_others_and_a_refuted_one_given_up() {
     let dir = tempfile::tempdir().unwrap();
     // A tuning seed the probe acquires.
     let sequence = common::seeded(dir.path(), "random-stereo", 113, 24);
+    // The confirm phase alone: the finger polish at its end would carry a polished state
+    // for another phase (`tests/tests/polish.rs`).
     let confirm = FinderConfig {
         confirm_frames: 5,
         confirm_hypotheses: 4,
         confirm_min_score: 0.0,
+        polish_margin: [-1.0, -1.0],
         ..FinderConfig::default()
     };
     let (k, after) = acquire(&sequence, confirm, 6);
