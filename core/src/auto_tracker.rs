@@ -225,6 +225,15 @@ fn largest_frame_pixels(cameras: &[Camera]) -> usize {
         .unwrap_or(0)
 }
 
+/// `state` (one value per model state) in a whole state's array, the rest 0.
+fn padded(state: &[f32]) -> [f32; MAX_STATES] {
+    let mut q = [0.0f32; MAX_STATES];
+    for (d, s) in q.iter_mut().zip(state) {
+        *d = *s;
+    }
+    q
+}
+
 /// One edge map per camera: `frames[i]`'s, built into `edge_buffers[i]`.
 fn edge_maps<'b>(
     edge_buffers: &'b mut [&mut [u8]],
@@ -570,11 +579,8 @@ impl AutoTracker {
     ) -> Result<f32, AutoError> {
         let likelihood = self.finder.acquirer().config().likelihood;
         let maps = edge_maps(edge_buffers, frames, &likelihood)?;
-        let mut q = [0.0f32; MAX_STATES];
         let tracker = self.multi.tracker();
-        for (d, s) in q.iter_mut().zip(tracker.state()) {
-            *d = *s;
-        }
+        let q = padded(tracker.state());
         let (_, worst) = self.finder.acquirer_mut().score_cameras(
             tracker.model(),
             tracker.cameras(),
@@ -680,11 +686,8 @@ impl AutoTracker {
         };
         let likelihood = self.finder.acquirer().config().likelihood;
         let maps = edge_maps(edge_buffers, frames, &likelihood)?;
-        let mut q = [0.0f32; MAX_STATES];
         let tracker = self.multi.tracker();
-        for (d, s) in q.iter_mut().zip(tracker.state()) {
-            *d = *s;
-        }
+        let q = padded(tracker.state());
         let (polished, score, before) = self.finder.acquirer_mut().polish_fingers(
             tracker.model(),
             tracker.cameras(),
@@ -717,10 +720,7 @@ impl AutoTracker {
         let mut carried: Vec<[f32; MAX_STATES], { MAX_KEEP + DEPTH_VARIANTS as usize }> =
             Vec::new();
         if let Some(share) = depth_share {
-            let mut q = [0.0f32; MAX_STATES];
-            for (d, s) in q.iter_mut().zip(tracker.state()) {
-                *d = *s;
-            }
+            let q = padded(tracker.state());
             for k in [DEPTH_FARTHER, DEPTH_NEARER] {
                 let moved = self
                     .finder
