@@ -213,7 +213,9 @@ struct Args {
     /// Print the best hypothesis' score and tip error on frames with several hypotheses; on
     /// every claimed frame, and for every refined leaf, the claim against the truth (both
     /// scored, the palm's offset and turn, the turn from the truth's depth-flipped reading,
-    /// each finger's joint RMS); and the truth's own score every 10th frame.
+    /// each finger's joint RMS); and the truth's own score every 10th frame. With
+    /// `--blackout`: each of the 30 frames after the return, its claim (or, unclaimed, the
+    /// truth) against the truth.
     #[arg(long)]
     trace: bool,
     /// The fingers' motion: `sweep` (the sweep's own), `off-centre` (each joint swinging near
@@ -788,6 +790,28 @@ fn blackout_run(
                 })
                 .collect();
             eprintln!("{label}: frame {k} state - truth: {}", d.join(" "));
+            let turn = digiteyes_core::quaternion::angle_between(
+                [st[0], st[1], st[2], st[3]],
+                [truth_k[0], truth_k[1], truth_k[2], truth_k[3]],
+            );
+            eprintln!(
+                "{label}: frame {k} palm turned {:.0} deg",
+                turn.to_degrees()
+            );
+        }
+        if args.trace && k >= dark.end && k < dark.end + 30 {
+            let images = kept::read_instant(sequence, k)?;
+            let views = kept::views(&images)?;
+            let claim = if claimed {
+                claim_against_truth(sequence, &views, auto.state(), &truth_k, &acquire)?
+            } else {
+                claim_against_truth(sequence, &views, &truth_k, &truth_k, &acquire)?
+            };
+            eprintln!(
+                "{label} {k} {} tip {e:.1} px {claim} hypotheses {}",
+                status_char(&report, was),
+                report.hypotheses
+            );
         }
         if dark.contains(&k) && claimed {
             out.dark_claimed += 1;
