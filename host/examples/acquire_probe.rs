@@ -469,6 +469,14 @@ fn claim_against_truth(
         / joints.len().max(1) as f32)
         .sqrt()
         .to_degrees();
+    let relative = nalgebra::Rotation3::from_matrix_unchecked(
+        digiteyes_core::quaternion::rotation(truth[0], truth[1], truth[2], truth[3]).transpose()
+            * digiteyes_core::quaternion::rotation(q[0], q[1], q[2], q[3]),
+    );
+    let axis = match relative.axis() {
+        Some(a) => format!("{:.2},{:.2},{:.2}", a.x, a.y, a.z),
+        None => "-".to_string(),
+    };
     let flip_deg = digiteyes_core::quaternion::angle_between(
         [q[0], q[1], q[2], q[3]],
         depth_flipped(&sequence.cameras[0], truth),
@@ -486,7 +494,7 @@ fn claim_against_truth(
         .collect();
     Ok(format!(
         "claim {claim_mean:.3}/{claim_worst:.3} truth {truth_mean:.3}/{truth_worst:.3} \
-         palm {palm_mm:.1} mm ({}) turn {turn_deg:.1} deg (flip {flip_deg:.1}) joints {joint_rms_deg:.1} deg \
+         palm {palm_mm:.1} mm ({}) turn {turn_deg:.1} deg about ({axis}) in the palm (flip {flip_deg:.1}) joints {joint_rms_deg:.1} deg \
          fingers {}",
         offset.join(","),
         fingers.join("/")
