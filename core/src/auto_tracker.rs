@@ -77,9 +77,6 @@ pub const LOCAL_REFINE_PASSES: u32 = 2;
 /// far from the last good state, is then closed in on over a few frames.
 pub const LOCAL_FOLLOW_SCORE: f32 = 0.8;
 
-/// How far the local re-acquisition turns the last good state's palm in its variants (rad).
-pub const LOCAL_TURN_RAD: f32 = 0.3;
-
 /// [`Acquirer::variant`]'s palm moved farther from the first camera.
 const DEPTH_FARTHER: u32 = 7;
 /// [`Acquirer::variant`]'s palm moved nearer to the first camera.
@@ -785,6 +782,7 @@ impl AutoTracker {
         } else {
             1 + (frame / 2) % (LOCAL_VARIANTS - 1)
         };
+        let turn_rad = self.finder.config().local_turn_rad;
         let seed = {
             let tracker = self.multi.tracker();
             let [shared, one_camera] = self.finder.config().local_depth_share;
@@ -793,13 +791,9 @@ impl AutoTracker {
             } else {
                 one_camera
             };
-            self.finder.acquirer().variant(
-                tracker.cameras(),
-                &self.held,
-                k,
-                LOCAL_TURN_RAD,
-                depth_share,
-            )
+            self.finder
+                .acquirer()
+                .variant(tracker.cameras(), &self.held, k, turn_rad, depth_share)
         };
         let followed = self.following.take();
         let replaced = {

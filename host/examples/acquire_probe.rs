@@ -133,6 +133,9 @@ struct Args {
     /// How far the local re-acquisition moves the palm in depth with one camera (a share).
     #[arg(long)]
     local_depth_mono: Option<f32>,
+    /// How far the local re-acquisition's variants turn the palm (rad)
+    #[arg(long)]
+    local_turn: Option<f32>,
     /// Score a leaf refined with the accepted one needs to join it.
     #[arg(long)]
     alternative_score: Option<f32>,
@@ -298,6 +301,7 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             Some(d) => Some(d),
             None => f.probation_max_drop,
         },
+        local_turn_rad: args.local_turn.unwrap_or(f.local_turn_rad),
         local_depth_share: [
             f.local_depth_share[0],
             args.local_depth_mono.unwrap_or(f.local_depth_share[1]),
@@ -780,6 +784,11 @@ fn blackout_run(
         let was = auto.status();
         let (report, claimed, e) = step_frame(sequence, &mut auto, &mut bufs, k, &truth_k)?;
         line.push(status_char(&report, was));
+        if args.trace && k == 0 {
+            if let Some(reference) = report.watch_score {
+                eprintln!("{label}: watch reference {reference:.3}");
+            }
+        }
         if args.verbose
             && (k + 4 >= dark.start && k < dark.start || k >= dark.end && k < dark.end + 12)
         {

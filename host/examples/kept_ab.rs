@@ -8,9 +8,9 @@
 //! period, samples, score memory, switch margin); `csmem`, `cswitch` the confirm phase's score
 //! memory and switch margin; `settle` the frames without the palm's position prior after an
 //! acquisition; `cdepth1` one camera's confirm-phase depth share; `cframes` its frames; `watch`
-//! its period, `drop` its bar; `depth1` one camera's local depth share; `probation` the
-//! acceptance's probation drop, negative: off; `budget` the search's evaluations a frame and
-//! camera). Each group's row also gives its frames far from the hand and not flagged (`far`)
+//! its period, `drop` its bar; `depth1` one camera's local depth share; `turn` the local
+//! re-acquisition's palm turn (rad); `probation` the acceptance's probation drop, negative:
+//! off; `budget` the search's evaluations a frame and camera). Each group's row also gives its frames far from the hand and not flagged (`far`)
 //! and the lost flag's precision and recall (`lostP`, `lostR`), as the benchmark counts them.
 //! Every variant after the first is also compared with the first seed by seed (paired):
 //! the mean change of track life, how many seeds gained or lost more than 5 points, and the

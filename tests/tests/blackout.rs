@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use digiteyes_core::acquire::{AcquireConfig, FinderConfig};
+use digiteyes_core::acquire::{AcquireConfig, FinderConfig, LOCAL_TURN_RAD};
 use digiteyes_core::auto_tracker::AutoTracker as CoreAutoTracker;
 use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::fill::FillConfig;
@@ -450,9 +450,18 @@ fn two_cameras_polish_the_fingers_of_a_re_acquisition_after_its_confirm_phase() 
     // tracker's defaults) are re-acquired only with it. (Seeds that show the mechanism, not a
     // sweep's verdict: over 2751-2910 and 2991-3230, 288 of the 323 seeds tracked to the
     // blackout are re-acquired with it and 281 without; docs/recovery.md.)
-    let with = FinderConfig::default();
-    assert_eq!(with.polish(2), Some(0.0), "on with two cameras by default");
-    assert_eq!(with.polish(1), None, "off with one");
+    // Both runs turn the local starts 0.3 rad, as when the polish was measured: with the
+    // wider turn (the default since), 3039 is re-acquired by neither.
+    assert_eq!(
+        FinderConfig::default().polish(2),
+        Some(0.0),
+        "on with two cameras by default"
+    );
+    assert_eq!(FinderConfig::default().polish(1), None, "off with one");
+    let with = FinderConfig {
+        local_turn_rad: 0.3,
+        ..FinderConfig::default()
+    };
     let without = FinderConfig {
         polish_margin: [-1.0, -1.0],
         ..with
@@ -483,4 +492,40 @@ fn two_cameras_polish_the_fingers_of_a_re_acquisition_after_its_confirm_phase() 
             "{seed} re-acquired without the polish: {line}"
         );
     }
+}
+
+#[test]
+fn the_local_reacquisition_turns_the_last_good_palm_far_enough_to_meet_a_rolled_hand() {
+    // While the hand is hidden its palm turns on; the local re-acquisition's variants turn
+    // the last good palm about each of its axes (`FinderConfig::local_turn_rad`). At 0.3 rad
+    // `random-stereo` 3214, whose hand came back rolled 40-50 degrees about its finger axis,
+    // was refined into a wrong hand and held; at 0.7 rad (the default) it is re-acquired.
+    // (A seed that shows the mechanism, not a sweep's verdict: over 583 seeds of 2751-3550,
+    // 531 of those tracked to the blackout are re-acquired at 0.7 rad and 522 at 0.3;
+    // docs/recovery.md.)
+    let with = FinderConfig::default();
+    assert_eq!(with.local_turn_rad, LOCAL_TURN_RAD);
+    assert!((LOCAL_TURN_RAD - 0.7).abs() < 1e-6, "0.7 rad by default");
+    let without = FinderConfig {
+        local_turn_rad: 0.3,
+        ..with
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let run = |finder| {
+        reacquired_after(
+            dir.path(),
+            "random-stereo",
+            3214,
+            140,
+            80..110,
+            finder,
+            TrackerConfig::default(),
+        )
+    };
+    let (back, line) = run(with);
+    println!("turned 0.7 rad: {line}");
+    assert!(back.is_some(), "not re-acquired turning 0.7 rad: {line}");
+    let (back, line) = run(without);
+    println!("turned 0.3 rad: {line}");
+    assert!(back.is_none(), "re-acquired turning 0.3 rad: {line}");
 }

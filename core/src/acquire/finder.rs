@@ -101,6 +101,12 @@ pub struct FinderConfig {
     /// one: a palm moved 15 % nearer was refined, accepted and held there, 90 mm from the
     /// hand and never flagged (measured: `docs/recovery.md`).
     pub local_depth_share: [f32; 2],
+    /// How far (rad) the local re-acquisition's variants turn the last good palm about each
+    /// of its axes (default [`LOCAL_TURN_RAD`], 0.7). While the hand is hidden the palm turns
+    /// on: at 0.3 rad the held palm of a hand that came back rolled 40–50° about its finger
+    /// axis was refined into a wrong hand and held (`docs/recovery.md`, "A wider turn among
+    /// the local starts").
+    pub local_turn_rad: f32,
     /// While confirming, another hypothesis replaces the best when its ranked score is this
     /// much more (likelihood units; default 0: the running mean below already keeps the
     /// output from flickering; the tracker's hypotheses use
@@ -228,6 +234,7 @@ impl Default for FinderConfig {
             local_frames_in_view: 8,
             probation_max_drop: Some(0.10),
             local_depth_share: [0.15, 0.0],
+            local_turn_rad: LOCAL_TURN_RAD,
             confirm_switch_margin: 0.0,
             confirm_score_memory: 0.6,
             settle_frames: 15,
@@ -236,6 +243,10 @@ impl Default for FinderConfig {
         }
     }
 }
+
+/// How far the local re-acquisition's variants turn the last good state's palm by default
+/// (rad; [`FinderConfig::local_turn_rad`]).
+pub const LOCAL_TURN_RAD: f32 = 0.7;
 
 /// Depth variants the confirm phase carries, when it carries them: the palm farther and
 /// nearer.
