@@ -49,7 +49,7 @@ use crate::config::{MAX_CAMERAS, MAX_HYPOTHESES, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
 use crate::hypotheses::{HypothesesConfig, Hypothesis, MultiReport, MultiTracker};
-use crate::likelihood::{EdgeMap, LikelihoodConfig, LikelihoodError};
+use crate::likelihood::{EdgeMap, LikelihoodConfig, LikelihoodError, Scene};
 use crate::model::Model;
 use crate::motion::PriorWeights;
 pub use crate::status::Status;
@@ -578,13 +578,8 @@ impl AutoTracker {
         let maps = edge_maps(edge_buffers, frames, &likelihood)?;
         let tracker = self.multi.tracker();
         let q = padded(tracker.state());
-        let (_, worst) = self.finder.acquirer_mut().score_cameras(
-            tracker.model(),
-            tracker.cameras(),
-            frames,
-            &maps,
-            &q,
-        );
+        let scene = Scene::new(tracker.model(), tracker.cameras(), frames, &maps);
+        let (_, worst) = self.finder.acquirer_mut().score_cameras(&scene, &q);
         Ok(worst)
     }
 
@@ -685,13 +680,8 @@ impl AutoTracker {
         let maps = edge_maps(edge_buffers, frames, &likelihood)?;
         let tracker = self.multi.tracker();
         let q = padded(tracker.state());
-        let (polished, score, before) = self.finder.acquirer_mut().polish_fingers(
-            tracker.model(),
-            tracker.cameras(),
-            frames,
-            &maps,
-            &q,
-        );
+        let scene = Scene::new(tracker.model(), tracker.cameras(), frames, &maps);
+        let (polished, score, before) = self.finder.acquirer_mut().polish_fingers(&scene, &q);
         if score > before + margin {
             self.carry(&[polished], false)?;
         }
@@ -813,13 +803,8 @@ impl AutoTracker {
         let library = if self.finder.config().local_library_pose {
             let tracker = self.multi.tracker();
             let palm = replaced.unwrap_or(seed);
-            let (q, _) = self.finder.acquirer_mut().best_pose(
-                tracker.model(),
-                tracker.cameras(),
-                frames,
-                maps,
-                &palm,
-            );
+            let scene = Scene::new(tracker.model(), tracker.cameras(), frames, maps);
+            let (q, _) = self.finder.acquirer_mut().best_pose(&scene, &palm);
             Some(q)
         } else {
             None
@@ -947,13 +932,8 @@ impl AutoTracker {
             }
         }
         let tracker = self.multi.tracker();
-        let (score, worst_camera) = self.finder.acquirer_mut().score_cameras(
-            tracker.model(),
-            tracker.cameras(),
-            frames,
-            maps,
-            &q,
-        );
+        let scene = Scene::new(tracker.model(), tracker.cameras(), frames, maps);
+        let (score, worst_camera) = self.finder.acquirer_mut().score_cameras(&scene, &q);
         Ok(Refined {
             score,
             worst_camera,

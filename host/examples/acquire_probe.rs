@@ -44,7 +44,7 @@ use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::Robust;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig, StateScorer};
+use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig, Scene, StateScorer};
 use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::render::hand_free::{hand_free, hand_free_frame, KINDS};
@@ -424,8 +424,8 @@ fn fine_columns(sequence: &Sequence, views: &[FrameView<'_>], q: &[f32]) -> Resu
             .zip(views)
             .map(|(b, v)| EdgeMap::build(b, v, &config).map_err(|e| anyhow!("{e}")))
             .collect::<Result<_>>()?;
-        let (mean, worst) =
-            scorer.score_cameras(&sequence.model, &sequence.cameras, views, &maps, q, &config);
+        let scene = Scene::new(&sequence.model, &sequence.cameras, views, &maps);
+        let (mean, worst) = scorer.score_cameras(&scene, q, &config);
         out.push_str(&format!(",{mean:.4},{worst:.4}"));
     }
     Ok(out)
@@ -443,16 +443,8 @@ fn claim_against_truth(
     let mut bufs = buffers(&sequence.cameras, acquire);
     let maps = edge_maps(&mut bufs, views, acquire)?;
     let mut scorer = StateScorer::new();
-    let mut score = |s: &[f32]| {
-        scorer.score_cameras(
-            &sequence.model,
-            &sequence.cameras,
-            views,
-            &maps,
-            s,
-            &acquire.likelihood,
-        )
-    };
+    let scene = Scene::new(&sequence.model, &sequence.cameras, views, &maps);
+    let mut score = |s: &[f32]| scorer.score_cameras(&scene, s, &acquire.likelihood);
     let (claim_mean, claim_worst) = score(q);
     let (truth_mean, truth_worst) = score(truth);
     let palm_mm = (4..7)

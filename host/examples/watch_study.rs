@@ -12,7 +12,7 @@ use anyhow::{anyhow, Result};
 use digiteyes_core::acquire::AcquireConfig;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::score::StateScorer;
-use digiteyes_core::likelihood::EdgeMap;
+use digiteyes_core::likelihood::{EdgeMap, Scene};
 use digiteyes_host::bench::robustness::{judge_frame, TRULY_LOST_TIP_PX_AT_640};
 use digiteyes_host::scenarios::{render_scenario, RenderOptions};
 use digiteyes_host::sequence::states::read_states_with_gaps;
@@ -102,14 +102,13 @@ fn score_run(seed: u64, seq: &Path, size: (u32, u32)) -> Result<()> {
         let q: Vec<f32> = estimate.iter().map(|&v| v as f32).collect();
         let mut each = Vec::new();
         for (c, camera) in sequence.cameras.iter().enumerate() {
-            each.push(scorer.score(
+            let scene = Scene::new(
                 &sequence.model,
                 core::slice::from_ref(camera),
                 &views[c..=c],
                 &maps[c..=c],
-                &q,
-                &likelihood,
-            ));
+            );
+            each.push(scorer.score(&scene, &q, &likelihood));
         }
         let mean = each.iter().sum::<f32>() / each.len() as f32;
         let worst = each.iter().copied().fold(f32::INFINITY, f32::min);

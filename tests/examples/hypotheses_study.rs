@@ -84,15 +84,9 @@ fn track(seq: &std::path::Path, (k, every): (u8, u8), out: &std::path::Path) -> 
             let t: Vec<f32> = truth.rows[f].iter().map(|&v| v as f32).collect();
             let model = multi.tracker().model();
             let cams = multi.tracker().cameras();
-            let st = scorer.score(model, cams, &views, &maps, &t, &config.likelihood);
-            let sb = scorer.score(
-                model,
-                cams,
-                &views,
-                &maps,
-                multi.state(),
-                &config.likelihood,
-            );
+            let scene = digiteyes_core::likelihood::Scene::new(model, cams, &views, &maps);
+            let st = scorer.score(&scene, &t, &config.likelihood);
+            let sb = scorer.score(&scene, multi.state(), &config.likelihood);
             margins.push(st - sb);
         }
     }

@@ -12,6 +12,7 @@ use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::{FreeMask, Robust};
 use digiteyes_core::fill::FillConfig;
 use digiteyes_core::frame::FrameView;
+use digiteyes_core::likelihood::Scene;
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::TrackerConfig;
@@ -141,7 +142,12 @@ fn the_search_keeps_its_budget_and_goes_on_where_it_left_off() {
         );
         let (mut steps, mut last) = (0, 0);
         let found = loop {
-            match acquirer.step(&sequence.model, &sequence.cameras, &views, &maps) {
+            match acquirer.step(&Scene::new(
+                &sequence.model,
+                &sequence.cameras,
+                &views,
+                &maps,
+            )) {
                 Progress::Searching { evaluated } => {
                     // The item under way is finished: a step overruns by less than one item,
                     // and an item is one hypothesis scored in every camera.
@@ -347,13 +353,11 @@ fn the_library_pose_that_scores_best_is_the_nearest_the_hand() {
             sequence,
             truth,
             mut acquirer,
-            views,
-            maps,
+            scene,
         } = f;
-        let (model, cameras) = (&sequence.model, &sequence.cameras);
         let n = sequence.n_states();
         let fist = acquirer.with_pose(&truth, FingerPose::Fist as usize);
-        let (chosen, score) = acquirer.best_pose(model, cameras, views, maps, &fist);
+        let (chosen, score) = acquirer.best_pose(&scene, &fist);
         assert_eq!(chosen[..7], truth[..7], "the palm is kept");
         let distance = |p: &[f32; MAX_STATES]| -> f32 {
             (7..n)
@@ -365,7 +369,7 @@ fn the_library_pose_that_scores_best_is_the_nearest_the_hand() {
             .map(|p| acquirer.with_pose(&truth, p))
             .collect();
         for (p, posed) in poses.iter().enumerate() {
-            let s = acquirer.score(model, cameras, views, maps, posed);
+            let s = acquirer.score(&scene, posed);
             println!(
                 "pose {p}: {:.2} rad from the fingers, score {s:.3}",
                 distance(posed)

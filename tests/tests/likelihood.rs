@@ -6,7 +6,7 @@
 
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::likelihood::{evaluate, EdgeMap, Likelihood, LikelihoodConfig};
+use digiteyes_core::likelihood::{evaluate, EdgeMap, Likelihood, LikelihoodConfig, Scene};
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_host::sequence::Sequence;
 
@@ -228,7 +228,8 @@ fn the_bounded_score_is_the_score_or_proves_it_is_under_the_bar() {
         let cameras = &sequence.cameras;
         let mut scorer = StateScorer::new();
         for p in scored_states(&q) {
-            let score = scorer.score(&sequence.model, cameras, &frames, &edges, &p, &config);
+            let scene = Scene::new(&sequence.model, cameras, &frames, &edges);
+            let score = scorer.score(&scene, &p, &config);
             for bar in [
                 f32::NEG_INFINITY,
                 score - 0.05,
@@ -238,8 +239,7 @@ fn the_bounded_score_is_the_score_or_proves_it_is_under_the_bar() {
                 0.6,
                 0.85,
             ] {
-                let bounded =
-                    scorer.score_above(&sequence.model, cameras, &frames, &edges, &p, &config, bar);
+                let bounded = scorer.score_above(&scene, &p, &config, bar);
                 let label = format!("{scenario} {seed}: score {score}, bar {bar}");
                 match bounded.score {
                     Some(s) => {

@@ -20,25 +20,19 @@ fn a_finger_curled_wrong_under_the_true_palm_is_polished_toward_the_truth() {
     // fist it started from.
     search::on_the_true_first_frame(|f| {
         let TrueFrame {
-            sequence,
             truth,
             mut acquirer,
-            views,
-            maps,
+            scene,
+            ..
         } = f;
-        let (model, cameras) = (&sequence.model, &sequence.cameras);
         let fist = acquirer.with_pose(&truth, FingerPose::Fist as usize);
         let mut start = truth;
         start[7..11].copy_from_slice(&fist[7..11]);
 
-        let (polished, score, before) =
-            acquirer.polish_fingers(model, cameras, views, maps, &start);
+        let (polished, score, before) = acquirer.polish_fingers(&scene, &start);
 
-        assert_eq!(before, acquirer.score(model, cameras, views, maps, &start));
-        assert_eq!(
-            score,
-            acquirer.score(model, cameras, views, maps, &polished)
-        );
+        assert_eq!(before, acquirer.score(&scene, &start));
+        assert_eq!(score, acquirer.score(&scene, &polished));
         assert!(score > before, "polished {score} against {before}");
         assert_eq!(polished[..7], start[..7], "the palm is kept");
         let index_error = |p: &[f32; MAX_STATES]| -> f32 {
@@ -66,22 +60,19 @@ fn a_polished_state_is_never_worse_and_each_finger_ends_at_its_best_library_pose
     // every library pose under the true palm of `fullhand-stereo`'s first frame.
     search::on_the_true_first_frame(|f| {
         let TrueFrame {
-            sequence,
             truth,
             mut acquirer,
-            views,
-            maps,
+            scene,
+            ..
         } = f;
-        let (model, cameras) = (&sequence.model, &sequence.cameras);
         for pose in 0..POSE_COUNT {
             let start = acquirer.with_pose(&truth, pose);
-            let (polished, score, before) =
-                acquirer.polish_fingers(model, cameras, views, maps, &start);
+            let (polished, score, before) = acquirer.polish_fingers(&scene, &start);
             assert!(score >= before, "pose {pose}: {score} under {before}");
             for other in 0..POSE_COUNT {
                 let mut thumb = acquirer.with_pose(&polished, other);
                 thumb[..FINGER_STARTS[4]].copy_from_slice(&polished[..FINGER_STARTS[4]]);
-                let s = acquirer.score(model, cameras, views, maps, &thumb);
+                let s = acquirer.score(&scene, &thumb);
                 assert!(
                     s <= score,
                     "pose {pose}: the thumb in pose {other} scores {s} over {score}"

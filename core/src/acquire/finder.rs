@@ -10,7 +10,7 @@ use heapless::Vec;
 use crate::config::{MAX_CAMERAS, MAX_STATES};
 use crate::estimator::Robust;
 use crate::frame::FrameView;
-use crate::likelihood::EdgeMap;
+use crate::likelihood::{EdgeMap, Scene};
 use crate::motion::PriorWeights;
 use crate::tracker::{FrameReport, RefineOverrides, Tracker, TrackerConfig, TrackerError};
 
@@ -358,9 +358,12 @@ impl Finder {
         self.last = None;
         self.found.clear();
         if self.leaves.is_empty() {
-            let progress = self
-                .acquirer
-                .step(tracker.model(), tracker.cameras(), frames, edges);
+            let progress = self.acquirer.step(&Scene::new(
+                tracker.model(),
+                tracker.cameras(),
+                frames,
+                edges,
+            ));
             let evaluated = match progress {
                 Progress::Searching { evaluated } => evaluated,
                 Progress::Found(_) => {
@@ -478,8 +481,8 @@ impl Finder {
         } else {
             let cameras = tracker.cameras();
             let n_cameras = cameras.len().min(MAX_CAMERAS);
-            self.acquirer
-                .score_cameras(tracker.model(), &cameras[..n_cameras], frames, edges, &q)
+            let scene = Scene::new(tracker.model(), &cameras[..n_cameras], frames, edges);
+            self.acquirer.score_cameras(&scene, &q)
         };
         Ok((
             self.config

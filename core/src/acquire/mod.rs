@@ -26,8 +26,9 @@ use heapless::Vec;
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_STATES};
 use crate::estimator::FreeMask;
-use crate::frame::FrameView;
-use crate::likelihood::{BoundedScore, EdgeMap, Likelihood, LikelihoodConfig, Region, Samples};
+use crate::likelihood::{
+    BoundedScore, EdgeMap, Likelihood, LikelihoodConfig, Region, Samples, Scene,
+};
 use crate::model::Model;
 use crate::nalgebra::{Vector2, Vector3};
 
@@ -315,22 +316,13 @@ impl Acquirer {
     /// Spends up to [`AcquireConfig::evaluations_per_frame`] on `frames` (one per camera,
     /// with their edge maps) and moves the search on.
     #[inline(never)] // a stage of the search: kept whole so profiles can attribute its cost
-    pub fn step(
-        &mut self,
-        model: &Model,
-        cameras: &[Camera],
-        frames: &[FrameView<'_>],
-        edges: &[EdgeMap<'_>],
-    ) -> Progress {
+    pub fn step(&mut self, scene: &Scene<'_>) -> Progress {
+        let (model, cameras) = (scene.model, scene.cameras);
         let mut regions: [Option<Region>; MAX_CAMERAS] = [None; MAX_CAMERAS];
-        for (r, e) in regions.iter_mut().zip(edges) {
+        for (r, e) in regions.iter_mut().zip(scene.edges) {
             *r = e.region;
         }
-        let n_cameras = cameras
-            .len()
-            .min(frames.len())
-            .min(edges.len())
-            .min(MAX_CAMERAS);
+        let n_cameras = scene.cameras_scored();
         let budget = self.budget(n_cameras);
         let regions = &regions[..n_cameras];
         let mut evaluated = 0u16;
@@ -370,15 +362,9 @@ impl Acquirer {
                 Some(last) if self.next.is_full() => last.score,
                 _ => f32::NEG_INFINITY,
             };
-            let bounded = self.scratch.score_above(
-                model,
-                cameras,
-                frames,
-                edges,
-                &q[..self.n_states],
-                &likelihood,
-                bar,
-            );
+            let bounded = self
+                .scratch
+                .score_above(scene, &q[..self.n_states], &likelihood, bar);
             if let Some(score) = bounded.score {
                 keep(&mut self.next, Candidate { score, q });
             }
@@ -451,16 +437,13 @@ impl Acquirer {
     /// cameras), with its score: [`POSE_COUNT`] evaluations in every camera.
     pub fn best_pose(
         &mut self,
-        model: &Model,
-        cameras: &[Camera],
-        frames: &[FrameView<'_>],
-        edges: &[EdgeMap<'_>],
+        scene: &Scene<'_>,
         q: &[f32; MAX_STATES],
     ) -> ([f32; MAX_STATES], f32) {
         let mut best = (*q, f32::NEG_INFINITY);
         for pose in 0..POSE_COUNT {
             let posed = self.with_pose(q, pose);
-            let score = self.score(model, cameras, frames, edges, &posed);
+            let score = self.score(scene, &posed);
             if score > best.1 {
                 best = (posed, score);
             }
@@ -476,13 +459,10 @@ impl Acquirer {
     /// Gauss–Newton, not of the likelihood.
     pub fn polish_fingers(
         &mut self,
-        model: &Model,
-        cameras: &[Camera],
-        frames: &[FrameView<'_>],
-        edges: &[EdgeMap<'_>],
+        scene: &Scene<'_>,
         q: &[f32; MAX_STATES],
     ) -> ([f32; MAX_STATES], f32, f32) {
-        let start = self.score(model, cameras, frames, edges, q);
+        let start = self.score(scene, q);
         let mut best = (*q, start);
         for finger in 0..FINGERS {
             let mut kept = best;
@@ -492,7 +472,7 @@ impl Acquirer {
                 if posed == best.0 {
                     continue;
                 }
-                let score = self.score(model, cameras, frames, edges, &posed);
+                let score = self.score(scene, &posed);
                 if score > kept.1 {
                     kept = (posed, score);
                 }
@@ -539,53 +519,29 @@ impl Acquirer {
     }
 
     /// The mean likelihood score of `q` over the cameras (0 when it cannot be posed).
-    pub fn score(
-        &mut self,
-        model: &Model,
-        cameras: &[Camera],
-        frames: &[FrameView<'_>],
-        edges: &[EdgeMap<'_>],
-        q: &[f32; MAX_STATES],
-    ) -> f32 {
-        self.score_cameras(model, cameras, frames, edges, q).0
+    pub fn score(&mut self, scene: &Scene<'_>, q: &[f32; MAX_STATES]) -> f32 {
+        self.score_cameras(scene, q).0
     }
 
     /// The mean and the worst likelihood score of `q` over the cameras (0 when it cannot be
     /// posed).
-    pub fn score_cameras(
-        &mut self,
-        model: &Model,
-        cameras: &[Camera],
-        frames: &[FrameView<'_>],
-        edges: &[EdgeMap<'_>],
-        q: &[f32; MAX_STATES],
-    ) -> (f32, f32) {
+    pub fn score_cameras(&mut self, scene: &Scene<'_>, q: &[f32; MAX_STATES]) -> (f32, f32) {
         let config = self.config.likelihood;
         self.scratch
-            .score_cameras(model, cameras, frames, edges, &q[..self.n_states], &config)
+            .score_cameras(scene, &q[..self.n_states], &config)
     }
 
     /// The likelihood of `q` in each camera into `out`; returns how many were scored (0 when
     /// `q` cannot be posed).
     pub fn likelihoods(
         &mut self,
-        model: &Model,
-        cameras: &[Camera],
-        frames: &[FrameView<'_>],
-        edges: &[EdgeMap<'_>],
+        scene: &Scene<'_>,
         q: &[f32; MAX_STATES],
         out: &mut [Likelihood; MAX_CAMERAS],
     ) -> usize {
         let config = self.config.likelihood;
-        self.scratch.likelihoods(
-            model,
-            cameras,
-            frames,
-            edges,
-            &q[..self.n_states],
-            &config,
-            out,
-        )
+        self.scratch
+            .likelihoods(scene, &q[..self.n_states], &config, out)
     }
 
     /// Without a region: the palm on the ray through the volume's centre, at depth `k` of

@@ -33,7 +33,7 @@ use crate::auto_tracker::AutoError;
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_CANDIDATES, MAX_HYPOTHESES};
 use crate::frame::FrameView;
-use crate::likelihood::EdgeMap;
+use crate::likelihood::{EdgeMap, Scene};
 use crate::state::{clamp_to_limit, renormalise_quaternion};
 use crate::tracker::{FrameReport, TrackMemory, Tracker, TrackerError};
 use score::StateScorer;
@@ -337,14 +337,8 @@ impl MultiTracker {
         }
         // 3. Scores.
         for c in candidates.iter_mut() {
-            let mut score = self.scorer.score(
-                self.tracker.model(),
-                self.tracker.cameras(),
-                frames,
-                &maps,
-                &c.memory.state,
-                &likelihood,
-            );
+            let scene = Scene::new(self.tracker.model(), self.tracker.cameras(), frames, &maps);
+            let mut score = self.scorer.score(&scene, &c.memory.state, &likelihood);
             if c.report.lost {
                 score -= self.config.lost_penalty;
             }

@@ -18,12 +18,14 @@ use crate::projection::ProjectedModel;
 mod edges;
 mod region;
 mod samples;
+mod scene;
 mod state;
 
 pub use edges::{EdgeMap, EDGE_BINS, GRADIENT_STEP_PX};
 pub use region::{Region, EXTENT_PERCENTILE, MAX_EXTENT_BINS, MIN_REGION_SAMPLES};
 use samples::ChamferSum;
 pub use samples::{visit, Samples, SilhouettePoint, MAX_SAMPLES, MAX_SAMPLES_PER_LINE};
+pub use scene::Scene;
 pub use state::{mean_score, BoundedScore, StateScorer, MIN_LINK_PX};
 
 /// Parameters of the edge map and of the score.

@@ -5,13 +5,12 @@
 
 use crate::camera::Camera;
 use crate::config::MAX_CAMERAS;
-use crate::frame::FrameView;
 use crate::kinematics::Poses;
 use crate::model::Model;
 use crate::projection::ProjectedModel;
 
 use super::{
-    add_silhouette, ceiling, evaluate, evaluate_edges, EdgeMap, Likelihood, LikelihoodConfig,
+    add_silhouette, ceiling, evaluate, evaluate_edges, Likelihood, LikelihoodConfig, Scene,
 };
 
 /// Shortest link drawn when scoring (px): the tracker's own default.
@@ -59,25 +58,25 @@ impl StateScorer {
 
     /// The likelihood of `q` (one value per model state) in each camera into `out`; returns
     /// how many were scored (0 when `q` cannot be posed).
-    #[allow(clippy::too_many_arguments)] // the state, the rig, its frames and edge maps, the score
     pub fn likelihoods(
         &mut self,
-        model: &Model,
-        cameras: &[Camera],
-        frames: &[FrameView<'_>],
-        edges: &[EdgeMap<'_>],
+        scene: &Scene<'_>,
         q: &[f32],
         config: &LikelihoodConfig,
         out: &mut [Likelihood; MAX_CAMERAS],
     ) -> usize {
-        if !self.pose(model, q) {
+        if !self.pose(scene.model, q) {
             return 0;
         }
         let mut n = 0;
-        for (((camera, frame), edges), slot) in
-            cameras.iter().zip(frames).zip(edges).zip(out.iter_mut())
+        for (((camera, frame), edges), slot) in scene
+            .cameras
+            .iter()
+            .zip(scene.frames)
+            .zip(scene.edges)
+            .zip(out.iter_mut())
         {
-            if !self.project(model, camera) {
+            if !self.project(scene.model, camera) {
                 return 0;
             }
             *slot = evaluate(&self.view, camera, frame, edges, config);
@@ -93,38 +92,35 @@ impl StateScorer {
     /// whose edges are scored and the [`ceiling`] for one not yet scored; a bound at or
     /// under `bar` ends it. What was computed is counted in the result, so a caller can
     /// charge for it.
-    #[allow(clippy::too_many_arguments)] // `score`'s arguments and the bar
     pub fn score_above(
         &mut self,
-        model: &Model,
-        cameras: &[Camera],
-        frames: &[FrameView<'_>],
-        edges: &[EdgeMap<'_>],
+        scene: &Scene<'_>,
         q: &[f32],
         config: &LikelihoodConfig,
         bar: f32,
     ) -> BoundedScore {
         let mut out = BoundedScore::default();
-        if !self.pose(model, q) {
+        if !self.pose(scene.model, q) {
             out.score = Some(0.0);
             return out;
         }
-        let n = cameras
-            .len()
-            .min(frames.len())
-            .min(edges.len())
-            .min(MAX_CAMERAS);
+        let n = scene.cameras_scored();
         let mut each = [Likelihood {
             score: ceiling(config),
             ..Likelihood::default()
         }; MAX_CAMERAS];
-        for (k, ((camera, frame), edges)) in
-            cameras.iter().zip(frames).zip(edges).enumerate().take(n)
+        for (k, ((camera, frame), edges)) in scene
+            .cameras
+            .iter()
+            .zip(scene.frames)
+            .zip(scene.edges)
+            .enumerate()
+            .take(n)
         {
             if mean_score(&each[..n]) <= bar {
                 return out;
             }
-            if !self.project(model, camera) {
+            if !self.project(scene.model, camera) {
                 out.score = Some(0.0);
                 return out;
             }
@@ -146,15 +142,12 @@ impl StateScorer {
     /// both 0 when `q` cannot be posed or no camera is given.
     pub fn score_cameras(
         &mut self,
-        model: &Model,
-        cameras: &[Camera],
-        frames: &[FrameView<'_>],
-        edges: &[EdgeMap<'_>],
+        scene: &Scene<'_>,
         q: &[f32],
         config: &LikelihoodConfig,
     ) -> (f32, f32) {
         let mut each = [Likelihood::default(); MAX_CAMERAS];
-        let n = self.likelihoods(model, cameras, frames, edges, q, config, &mut each);
+        let n = self.likelihoods(scene, q, config, &mut each);
         if n == 0 {
             return (0.0, 0.0);
         }
@@ -167,17 +160,8 @@ impl StateScorer {
 
     /// The mean likelihood score of `q` over the cameras (0..=1, higher is better); 0 when
     /// `q` cannot be posed or no camera is given.
-    pub fn score(
-        &mut self,
-        model: &Model,
-        cameras: &[Camera],
-        frames: &[FrameView<'_>],
-        edges: &[EdgeMap<'_>],
-        q: &[f32],
-        config: &LikelihoodConfig,
-    ) -> f32 {
-        self.score_cameras(model, cameras, frames, edges, q, config)
-            .0
+    pub fn score(&mut self, scene: &Scene<'_>, q: &[f32], config: &LikelihoodConfig) -> f32 {
+        self.score_cameras(scene, q, config).0
     }
 }
 

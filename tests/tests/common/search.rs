@@ -8,7 +8,7 @@ use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig};
+use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig, Scene};
 use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::tracker::TrackerConfig;
 use digiteyes_host::sequence::Sequence;
@@ -182,13 +182,12 @@ pub fn format_errors(errors: &[Option<f32>]) -> String {
 
 /// What a test of the library's finger poses needs on `fullhand-stereo`'s first frame (a
 /// relaxed, slightly spread hand): the sequence, its true state (every model state), an
-/// acquirer with the default search, and the frame's views and edge maps.
+/// acquirer with the default search, and the frame as the likelihood sees it.
 pub struct TrueFrame<'a> {
     pub sequence: &'a Sequence,
     pub truth: [f32; MAX_STATES],
     pub acquirer: Acquirer,
-    pub views: &'a [FrameView<'a>],
-    pub maps: &'a [EdgeMap<'a>],
+    pub scene: Scene<'a>,
 }
 
 /// Runs `test` on [`TrueFrame`].
@@ -211,7 +210,6 @@ pub fn on_the_true_first_frame(test: impl FnOnce(TrueFrame<'_>)) {
         sequence: &sequence,
         truth,
         acquirer: acquirer(&sequence, acquire),
-        views: &views,
-        maps: &maps,
+        scene: Scene::new(&sequence.model, &sequence.cameras, &views, &maps),
     });
 }
