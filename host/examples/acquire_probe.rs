@@ -133,7 +133,7 @@ struct Args {
     /// How far the local re-acquisition moves the palm in depth with one camera (a share).
     #[arg(long)]
     local_depth_mono: Option<f32>,
-    /// How far the local re-acquisition's variants turn the palm (rad)
+    /// How far the local re-acquisition's variants turn the palm (rad).
     #[arg(long)]
     local_turn: Option<f32>,
     /// Score a leaf refined with the accepted one needs to join it.
@@ -811,11 +811,8 @@ fn blackout_run(
         if args.trace && k >= dark.end && k < dark.end + 30 {
             let images = kept::read_instant(sequence, k)?;
             let views = kept::views(&images)?;
-            let claim = if claimed {
-                claim_against_truth(sequence, &views, auto.state(), &truth_k, &acquire)?
-            } else {
-                claim_against_truth(sequence, &views, &truth_k, &truth_k, &acquire)?
-            };
+            let held: &[f32] = if claimed { auto.state() } else { &truth_k };
+            let claim = claim_against_truth(sequence, &views, held, &truth_k, &acquire)?;
             eprintln!(
                 "{label} {k} {} tip {e:.1} px {claim} hypotheses {}",
                 status_char(&report, was),
