@@ -189,6 +189,44 @@ fn the_search_keeps_its_budget_and_goes_on_where_it_left_off() {
     }
 }
 
+#[test]
+fn a_step_after_evaluations_spent_elsewhere_spends_only_what_is_left() {
+    let dir = tempfile::tempdir().unwrap();
+    for (rig, seed) in [("random-mono", 101), ("random-stereo", 102)] {
+        let sequence = common::seeded(dir.path(), rig, seed, 1);
+        let images = frames::images(&sequence, 0);
+        let views = frames::views(&images);
+        let config = AcquireConfig::default();
+        let mut bufs = search::buffers(&sequence.cameras, config.likelihood.stride_px);
+        let maps = search::edge_maps(&mut bufs, &views, &config.likelihood);
+        let scene = Scene::new(&sequence.model, &sequence.cameras, &views, &maps);
+        let budget = search::acquirer(&sequence, config).budget(sequence.cameras.len());
+        for spent in [0, budget / 3, budget - 1, budget, budget.saturating_mul(4)] {
+            let mut acquirer = search::acquirer(&sequence, config);
+            let Progress::Searching { evaluated } = acquirer.step_after(&scene, spent) else {
+                panic!("{rig}: one step found the hand");
+            };
+            let left = budget.saturating_sub(spent).max(1);
+            assert!(
+                evaluated < left + acquirer.largest_item_cost,
+                "{rig}, {spent} spent: {evaluated} evaluated, {left} left"
+            );
+            assert!(
+                acquirer.evaluations > 0,
+                "{rig}, {spent} spent: the search still moves on"
+            );
+            if spent == 0 {
+                let mut plain = search::acquirer(&sequence, config);
+                assert_eq!(
+                    plain.step(&scene),
+                    Progress::Searching { evaluated },
+                    "{rig}: nothing spent elsewhere is the plain step"
+                );
+            }
+        }
+    }
+}
+
 /// `rig` at `seed` (34 frames, 320×240) searched from nothing by the status machine under
 /// `tracker`: per frame, whether a hand was claimed within 5 px of the truth, and the line
 /// `y` (claimed, right) / `n` (claimed, wrong) / `.` (none).

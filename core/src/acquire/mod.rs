@@ -315,15 +315,21 @@ impl Acquirer {
 
     /// Spends up to [`AcquireConfig::evaluations_per_frame`] on `frames` (one per camera,
     /// with their edge maps) and moves the search on.
-    #[inline(never)] // a stage of the search: kept whole so profiles can attribute its cost
     pub fn step(&mut self, scene: &Scene<'_>) -> Progress {
+        self.step_after(scene, 0)
+    }
+
+    /// [`Acquirer::step`] on a frame that has already spent `spent` evaluations of its budget
+    /// elsewhere (at least one is still spent here, so the search always moves on).
+    #[inline(never)] // a stage of the search: kept whole so profiles can attribute its cost
+    pub fn step_after(&mut self, scene: &Scene<'_>, spent: u16) -> Progress {
         let (model, cameras) = (scene.model, scene.cameras);
         let mut regions: [Option<Region>; MAX_CAMERAS] = [None; MAX_CAMERAS];
         for (r, e) in regions.iter_mut().zip(scene.edges) {
             *r = e.region;
         }
         let n_cameras = scene.cameras_scored();
-        let budget = self.budget(n_cameras);
+        let budget = self.budget(n_cameras).saturating_sub(spent).max(1);
         let regions = &regions[..n_cameras];
         let mut evaluated = 0u16;
         while evaluated < budget && self.stage != Stage::Done {
