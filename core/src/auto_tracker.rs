@@ -6,7 +6,11 @@
 //!   Gauss–Newton on the frames that follow and judged by the likelihood in every camera
 //!   ([`AcceptConfig`]); an accepted leaf is taken for the hand — claimed from the next
 //!   frame, if that frame confirms it ([`FinderConfig::probation_max_drop`]) — and when
-//!   every leaf is refused the search starts over.
+//!   every leaf is refused the search starts over. With one camera, a refused leaf that
+//!   scored at least [`FinderConfig::pursue_score`] is *pursued*: refined again and judged on
+//!   each of the next [`FinderConfig::pursue_frames`] searching frames ([`PURSUIT_PASSES`]
+//!   tracker pass a frame), beside the search, which spends [`PURSUIT_EVALUATIONS_PER_CAMERA`]
+//!   less of its budget on those frames.
 //! - **Tracking**: the tracker runs — one hypothesis, or several ([`MultiTracker`], set by
 //!   [`AutoTracker::set_hypotheses`]); a lost frame makes the status [`Status::Lost`]. Every
 //!   few frames (eight at 320×240) the [watch](crate::watch) scores the tracked state by the likelihood in every
@@ -71,6 +75,14 @@ pub const LOCAL_WINDOW: f32 = 0.25;
 /// Gauss–Newton passes (each a whole tracker frame, restarted fresh) over a placed state in
 /// the local re-acquisition.
 pub const LOCAL_REFINE_PASSES: u32 = 2;
+
+/// Tracker passes a pursued leaf is refined by on a frame ([`FinderConfig::pursue_frames`]).
+pub const PURSUIT_PASSES: u32 = 1;
+
+/// What pursuing a refused leaf on a frame ([`PURSUIT_PASSES`] tracker passes and a score)
+/// costs against the search's budget, in evaluations per camera: a tracker pass costs about
+/// as much as 16 of the search's scores.
+pub const PURSUIT_EVALUATIONS_PER_CAMERA: u16 = 20;
 
 /// A refined local hypothesis scoring at least this (but under the acceptance score) is
 /// followed to the next frame, where it is refined again: a hand half back in view, or moved
@@ -266,6 +278,9 @@ pub struct AutoTracker {
     /// The best refined local hypothesis of the last frame, when it scored at least
     /// [`LOCAL_FOLLOW_SCORE`]: refined again on the next.
     following: Option<[f32; MAX_STATES]>,
+    /// A refused leaf of the global search still pursued, the searching frames left
+    /// ([`FinderConfig::pursue_frames`]) and its last score.
+    pursued: Option<([f32; MAX_STATES], u8, f32)>,
     /// Local re-acquisition frames since the loss on which a start was refined without being
     /// lost (the hand is back in view) but none was accepted.
     local_in_view: u32,
@@ -319,6 +334,7 @@ impl AutoTracker {
             ever_tracked: false,
             local_left: 0,
             following: None,
+            pursued: None,
             local_in_view: 0,
             recovery: Recovery::Search,
             watch: Watch::new(WatchConfig::default(), largest_frame_pixels(cameras)),
@@ -516,6 +532,7 @@ impl AutoTracker {
             {
                 self.finder.restart();
                 self.following = None;
+                self.pursued = None;
                 self.confirm_left = 0;
                 self.settle_left = 0;
                 self.polish_left = 0;
@@ -553,6 +570,7 @@ impl AutoTracker {
     ) -> AutoReport {
         self.finder.restart();
         self.following = None;
+        self.pursued = None;
         self.confirm_left = 0;
         self.settle_left = 0;
         self.polish_left = 0;
@@ -597,6 +615,7 @@ impl AutoTracker {
     /// Returns whether it is claimed now.
     fn found(&mut self, worst_camera: f32) -> bool {
         let local_left = self.local_left;
+        self.pursued = None;
         self.confirm_left = 0;
         self.polish_left = 0;
         self.multi.set_config(self.hypotheses);
@@ -847,7 +866,7 @@ impl AutoTracker {
                 LocalStart::Library => library,
             };
             let Some(q) = q else { continue };
-            let r = self.refine(frames, maps, q, n)?;
+            let r = self.refine(frames, maps, q, n, LOCAL_REFINE_PASSES)?;
             out.evaluated = out.evaluated.saturating_add(1);
             let _ = refined.push(r);
         }
@@ -901,7 +920,7 @@ impl AutoTracker {
         Ok(())
     }
 
-    /// `start` refined by [`LOCAL_REFINE_PASSES`] fresh tracker passes on this frame (under
+    /// `start` refined by `passes` fresh tracker passes on this frame (under
     /// the search's [`FinderConfig::leaf_robust`] and edge test), and its mean and worst camera's
     /// likelihood score (0 when the tracker calls it lost).
     fn refine(
@@ -910,6 +929,7 @@ impl AutoTracker {
         maps: &[EdgeMap<'_>],
         start: [f32; MAX_STATES],
         n: usize,
+        passes: u32,
     ) -> Result<Refined, AutoError> {
         let mut q = start;
         let mut report = FrameReport::default();
@@ -918,7 +938,7 @@ impl AutoTracker {
             .config()
             .local_overrides(self.multi.tracker().config());
         let tracker = self.multi.tracker_mut();
-        for _ in 0..LOCAL_REFINE_PASSES {
+        for _ in 0..passes.max(1) {
             tracker.restart_fresh(&q[..n])?;
             report = tracker.track_under(&overrides, frames)?;
             q[..n].copy_from_slice(&tracker.state()[..n]);
@@ -940,6 +960,49 @@ impl AutoTracker {
             q,
             report,
         })
+    }
+
+    /// The refused leaf pursued ([`FinderConfig::pursue_frames`]), refined again on this
+    /// frame and judged: returns whether it was accepted (the hand is found, its confirm
+    /// phase begun).
+    fn pursue(
+        &mut self,
+        frames: &[FrameView<'_>],
+        maps: &[EdgeMap<'_>],
+        out: &mut AutoReport,
+    ) -> Result<bool, AutoError> {
+        let Some((q, left, _)) = self.pursued.take() else {
+            return Ok(false);
+        };
+        let n = self.multi.tracker().model().n_states().min(MAX_STATES);
+        let r = self.refine(frames, maps, q, n, PURSUIT_PASSES)?;
+        out.evaluated = out.evaluated.saturating_add(1);
+        let finder = *self.finder.config();
+        let cameras = self.multi.tracker().cameras().len();
+        let verdict = finder
+            .accept
+            .judge(cameras, r.score, r.worst_camera, r.report.lost);
+        let rig = usize::from(cameras < 2);
+        if verdict.accepted {
+            self.finder.restart();
+            self.multi.tracker_mut().restart_fresh(&r.q[..n])?;
+            let claimed = self.found(r.worst_camera);
+            self.confirm(&[], true)?;
+            out.leaf_score = Some(r.score);
+            out.accepted = true;
+            out.status = self.status();
+            out.report = FrameReport {
+                lost: !claimed,
+                ..r.report
+            };
+            return Ok(true);
+        }
+        out.leaf_score = Some(r.score);
+        let bar = finder.pursue_score[rig];
+        if left > 1 && !r.report.lost && r.score >= bar {
+            self.pursued = Some((r.q, left - 1, r.score));
+        }
+        Ok(false)
     }
 
     /// A searching frame: the search moves on, or some of its leaves are refined and judged.
@@ -967,14 +1030,39 @@ impl AutoTracker {
             self.local_search(frames, &maps, &mut out)?;
             return Ok(out);
         }
-        match self.finder.step(self.multi.tracker_mut(), frames, &maps)? {
+        let pursued = self.pursued.is_some();
+        if self.pursue(frames, &maps, &mut out)? {
+            return Ok(out);
+        }
+        let spent = if pursued {
+            PURSUIT_EVALUATIONS_PER_CAMERA.saturating_mul(frames.len() as u16)
+        } else {
+            0
+        };
+        match self
+            .finder
+            .step_after(self.multi.tracker_mut(), frames, &maps, spent)?
+        {
             FinderStep::Searching {
                 evaluated,
                 best_leaf,
                 ..
             } => {
-                out.evaluated = evaluated;
-                out.leaf_score = best_leaf.map(|v| v.score);
+                out.evaluated = out.evaluated.saturating_add(evaluated);
+                if let Some(v) = best_leaf {
+                    out.leaf_score = Some(out.leaf_score.map_or(v.score, |s| s.max(v.score)));
+                }
+                let finder = *self.finder.config();
+                let cameras = self.multi.tracker().cameras().len();
+                let rig = usize::from(cameras < 2);
+                let (bar, pursue_frames) = (finder.pursue_score[rig], finder.pursue_frames[rig]);
+                if let (Some(v), Some((_, q))) = (best_leaf, self.finder.last_leaf()) {
+                    // A leaf replaces the one pursued only if it scores more.
+                    let better = self.pursued.is_none_or(|(_, _, score)| v.score > score);
+                    if pursue_frames > 0 && !v.lost && v.score >= bar && better {
+                        self.pursued = Some((*q, pursue_frames, v.score));
+                    }
+                }
             }
             FinderStep::Found { verdict, report } => {
                 let claimed = self.found(verdict.worst_camera);

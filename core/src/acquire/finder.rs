@@ -136,6 +136,19 @@ pub struct FinderConfig {
     /// track had: there a variant was taken 80–95 mm off and held, unflagged
     /// (`docs/recovery.md`, "One camera's confirm phase tries the depth again").
     pub confirm_depth_share: [f32; 2],
+    /// A leaf of the global search refused by the acceptance but scoring at least this, with
+    /// two or more cameras (`[0]`) and with one (`[1]`), is pursued: refined again on each of
+    /// the next [`FinderConfig::pursue_frames`] searching frames (one tracker pass a frame),
+    /// beside the search, and judged by the same acceptance every time; it is dropped when
+    /// it scores under this. One camera's leaves come within a few pixels of the hand but
+    /// score under the bar on the frame they are refined on, and Gauss–Newton on the next
+    /// frames brings some onto it (`docs/recovery.md`, "A refused leaf pursued").
+    pub pursue_score: [f32; 2],
+    /// Frames a refused leaf is pursued for, with two or more cameras (`[0]`, default 0:
+    /// never) and with one (`[1]`, default 2). More frames acquire a little more and let a
+    /// leaf creep onto a still cluttered scene: at 6, 148 of 1,000 hand-free frames of one
+    /// still scene were claimed.
+    pub pursue_frames: [u8; 2],
     /// When a confirm phase ends, each finger of its best is given the library's pose that
     /// scores best on the frame ([`Acquirer::polish_fingers`](super::Acquirer::polish_fingers));
     /// when that raises the score by more than this, with two or more cameras (`[0]`) and
@@ -239,6 +252,8 @@ impl Default for FinderConfig {
             confirm_score_memory: 0.6,
             settle_frames: 15,
             confirm_depth_share: [0.0, 0.12],
+            pursue_score: [0.85, 0.88],
+            pursue_frames: [0, 2],
             polish_margin: [0.0, -1.0],
         }
     }
@@ -355,15 +370,26 @@ impl Finder {
         frames: &[FrameView<'_>],
         edges: &[EdgeMap<'_>],
     ) -> Result<FinderStep, TrackerError> {
+        self.step_after(tracker, frames, edges, 0)
+    }
+
+    /// [`Finder::step`] on a frame that has already spent `spent` evaluations of the
+    /// search's budget elsewhere ([`Acquirer::step_after`]; a frame of leaves refines its
+    /// leaves whatever was spent).
+    pub fn step_after(
+        &mut self,
+        tracker: &mut Tracker,
+        frames: &[FrameView<'_>],
+        edges: &[EdgeMap<'_>],
+        spent: u16,
+    ) -> Result<FinderStep, TrackerError> {
         self.last = None;
         self.found.clear();
         if self.leaves.is_empty() {
-            let progress = self.acquirer.step(&Scene::new(
-                tracker.model(),
-                tracker.cameras(),
-                frames,
-                edges,
-            ));
+            let progress = self.acquirer.step_after(
+                &Scene::new(tracker.model(), tracker.cameras(), frames, edges),
+                spent,
+            );
             let evaluated = match progress {
                 Progress::Searching { evaluated } => evaluated,
                 Progress::Found(_) => {

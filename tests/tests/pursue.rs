@@ -1,0 +1,50 @@
+//! With one camera, a leaf of the global search that the acceptance refuses but that scores
+//! at least `FinderConfig::pursue_score` is pursued: refined again on the next
+//! `FinderConfig::pursue_frames` searching frames, beside the search (which spends that much
+//! less of its budget), and judged by the same acceptance each time. On these mono seeds the
+//! search's leaves come within a few pixels of the hand but score under the one-camera bar on
+//! the frame they are refined on (`acquire_probe --trace`); refined again on the next frames
+//! one of them reaches the bar, and the hand is acquired where without the pursuit the first
+//! 30 frames never claim it.
+
+use digiteyes_core::acquire::FinderConfig;
+
+mod common;
+use common::search::{self, acquire_mono, WITHIN_FRAMES};
+
+/// The search's defaults with no leaf pursued.
+fn without_pursuit() -> FinderConfig {
+    FinderConfig {
+        pursue_frames: [0, 0],
+        ..FinderConfig::default()
+    }
+}
+
+#[test]
+fn a_refused_leaf_pursued_over_the_next_frames_is_acquired() {
+    let [two_cameras, one_camera] = FinderConfig::default().pursue_frames;
+    assert!(
+        one_camera > 0 && two_cameras == 0,
+        "one camera pursues refused leaves by default, two cameras do not"
+    );
+    for seed in [10224, 10236] {
+        let with = acquire_mono(seed, FinderConfig::default());
+        let without = acquire_mono(seed, without_pursuit());
+        println!(
+            "seed {seed} with the pursuit: {}",
+            search::format_errors(&with.errors)
+        );
+        println!(
+            "seed {seed} without it: {}",
+            search::format_errors(&without.errors)
+        );
+        assert!(
+            with.held.is_some(),
+            "seed {seed}: with the pursuit the hand is acquired within {WITHIN_FRAMES} frames"
+        );
+        assert!(
+            without.errors.iter().all(Option::is_none),
+            "seed {seed}: without it no frame claims the hand"
+        );
+    }
+}
