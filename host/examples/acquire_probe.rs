@@ -180,6 +180,14 @@ struct Args {
     /// with one camera (default: the search's; two cameras keep theirs).
     #[arg(long)]
     confirm_depth: Option<f32>,
+    /// The score a refused leaf needs to be pursued: two cameras, one camera (`A,B`; default:
+    /// the search's)
+    #[arg(long, value_delimiter = ',')]
+    pursue_score: Option<Vec<f32>>,
+    /// Searching frames a refused leaf is pursued for: two cameras, one camera (`A,B`; 0:
+    /// never; default: the search's)
+    #[arg(long, value_delimiter = ',')]
+    pursue_frames: Option<Vec<u8>>,
     /// The margin a confirm phase's best with each finger polished must score by to be
     /// carried for another phase: two cameras, one camera (`A,B`; negative: never; default:
     /// the search's).
@@ -313,6 +321,14 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             f.confirm_depth_share[0],
             args.confirm_depth.unwrap_or(f.confirm_depth_share[1]),
         ],
+        pursue_score: match args.pursue_score.as_deref() {
+            Some([two, one]) => [*two, *one],
+            _ => f.pursue_score,
+        },
+        pursue_frames: match args.pursue_frames.as_deref() {
+            Some([two, one]) => [*two, *one],
+            _ => f.pursue_frames,
+        },
         polish_margin: match args.polish_margin.as_deref() {
             Some([two, one]) => [*two, *one],
             _ => f.polish_margin,
@@ -646,6 +662,16 @@ fn run(
         let (report, claimed, e) = step_frame(sequence, &mut auto, &mut bufs, k, &truth_k)?;
         if was == Status::Searching && !report.local {
             out.evaluations += u64::from(report.evaluated);
+            if args.trace && report.accepted {
+                let by_leaf = auto.finder().last_leaf().is_some_and(|(v, _)| v.accepted);
+                let q = auto.tracker().state();
+                let e = tip_error_px(&sequence.model, &sequence.cameras, q, &truth_k);
+                eprintln!(
+                    "acceptance {label} {k} {} score {:.3} tip {e:.1} px",
+                    if by_leaf { "leaf" } else { "pursued" },
+                    report.leaf_score.unwrap_or(0.0)
+                );
+            }
             if report.leaf_score.is_some() {
                 out.refined += 1;
             }
@@ -1034,6 +1060,12 @@ fn hand_free_status_run(sequence: &Sequence, args: &Args, frames: usize) -> Resu
         let report = auto
             .step(&views, &mut buffers)
             .map_err(|e| anyhow!("{e}"))?;
+        if args.trace && report.accepted {
+            eprintln!(
+                "hand-free acceptance {k} score {:.3}",
+                report.leaf_score.unwrap_or(0.0)
+            );
+        }
         if report.status != Status::Searching && !report.report.lost {
             claimed += 1;
             eprintln!(

@@ -10,7 +10,8 @@
 //! acquisition; `cdepth1` one camera's confirm-phase depth share; `cframes` its frames; `watch`
 //! its period, `drop` its bar; `depth1` one camera's local depth share; `turn` the local
 //! re-acquisition's palm turn (rad); `probation` the acceptance's probation drop, negative:
-//! off; `budget` the search's evaluations a frame and camera). Each group's row also gives its frames far from the hand and not flagged (`far`)
+//! off; `budget` the search's evaluations a frame and camera; `pursue1` the searching frames
+//! one camera pursues a refused leaf, 0: never). Each group's row also gives its frames far from the hand and not flagged (`far`)
 //! and the lost flag's precision and recall (`lostP`, `lostR`), as the benchmark counts them.
 //! Every variant after the first is also compared with the first seed by seed (paired):
 //! the mean change of track life, how many seeds gained or lost more than 5 points, and the

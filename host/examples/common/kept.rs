@@ -113,6 +113,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "drop" => o.watch.max_drop = f,
             "depth1" => o.finder.local_depth_share[1] = f,
             "turn" => o.finder.local_turn_rad = f,
+            "pursue1" => o.finder.pursue_frames[1] = f as u8,
             "probation" => o.finder.probation_max_drop = (f >= 0.0).then_some(f),
             "budget" => o.acquire.evaluations_per_frame = f as u16,
             _ => bail!("unknown key {k}"),
