@@ -122,17 +122,27 @@ fn hand_free_frames_are_never_claimed() {
     }
 }
 
-#[test]
-fn the_search_keeps_its_budget_and_goes_on_where_it_left_off() {
+/// `test` on the first frame of `random-mono` 101 and `random-stereo` 102 (320×240), with
+/// its edge maps built as the search's defaults build them.
+fn on_first_frames(mut test: impl FnMut(&str, &Sequence, &Scene<'_>)) {
     let dir = tempfile::tempdir().unwrap();
     for (rig, seed) in [("random-mono", 101), ("random-stereo", 102)] {
         let sequence = common::seeded(dir.path(), rig, seed, 1);
         let images = frames::images(&sequence, 0);
         let views = frames::views(&images);
+        let likelihood = AcquireConfig::default().likelihood;
+        let mut bufs = search::buffers(&sequence.cameras, likelihood.stride_px);
+        let maps = search::edge_maps(&mut bufs, &views, &likelihood);
+        let scene = Scene::new(&sequence.model, &sequence.cameras, &views, &maps);
+        test(rig, &sequence, &scene);
+    }
+}
+
+#[test]
+fn the_search_keeps_its_budget_and_goes_on_where_it_left_off() {
+    on_first_frames(|rig, sequence, scene| {
         let config = AcquireConfig::default();
-        let mut bufs = search::buffers(&sequence.cameras, config.likelihood.stride_px);
-        let maps = search::edge_maps(&mut bufs, &views, &config.likelihood);
-        let mut acquirer = search::acquirer(&sequence, config);
+        let mut acquirer = search::acquirer(sequence, config);
         // The budget is per camera: a stereo step scores as many hypotheses as a mono one.
         let budget = acquirer.budget(sequence.cameras.len());
         assert_eq!(
@@ -142,12 +152,7 @@ fn the_search_keeps_its_budget_and_goes_on_where_it_left_off() {
         );
         let (mut steps, mut last) = (0, 0);
         let found = loop {
-            match acquirer.step(&Scene::new(
-                &sequence.model,
-                &sequence.cameras,
-                &views,
-                &maps,
-            )) {
+            match acquirer.step(scene) {
                 Progress::Searching { evaluated } => {
                     // The item under way is finished: a step overruns by less than one item,
                     // and an item is one hypothesis scored in every camera.
@@ -186,24 +191,17 @@ fn the_search_keeps_its_budget_and_goes_on_where_it_left_off() {
         let most = if sequence.cameras.len() == 1 { 7 } else { 12 };
         assert!(steps <= most, "{rig}: the search took {steps} frames");
         assert!(found.score > 0.5 && acquirer.best().len() > 1);
-    }
+    });
 }
 
 #[test]
 fn a_step_after_evaluations_spent_elsewhere_spends_only_what_is_left() {
-    let dir = tempfile::tempdir().unwrap();
-    for (rig, seed) in [("random-mono", 101), ("random-stereo", 102)] {
-        let sequence = common::seeded(dir.path(), rig, seed, 1);
-        let images = frames::images(&sequence, 0);
-        let views = frames::views(&images);
+    on_first_frames(|rig, sequence, scene| {
         let config = AcquireConfig::default();
-        let mut bufs = search::buffers(&sequence.cameras, config.likelihood.stride_px);
-        let maps = search::edge_maps(&mut bufs, &views, &config.likelihood);
-        let scene = Scene::new(&sequence.model, &sequence.cameras, &views, &maps);
-        let budget = search::acquirer(&sequence, config).budget(sequence.cameras.len());
+        let budget = search::acquirer(sequence, config).budget(sequence.cameras.len());
         for spent in [0, budget / 3, budget - 1, budget, budget.saturating_mul(4)] {
-            let mut acquirer = search::acquirer(&sequence, config);
-            let Progress::Searching { evaluated } = acquirer.step_after(&scene, spent) else {
+            let mut acquirer = search::acquirer(sequence, config);
+            let Progress::Searching { evaluated } = acquirer.step_after(scene, spent) else {
                 panic!("{rig}: one step found the hand");
             };
             let left = budget.saturating_sub(spent).max(1);
@@ -216,15 +214,15 @@ fn a_step_after_evaluations_spent_elsewhere_spends_only_what_is_left() {
                 "{rig}, {spent} spent: the search still moves on"
             );
             if spent == 0 {
-                let mut plain = search::acquirer(&sequence, config);
+                let mut plain = search::acquirer(sequence, config);
                 assert_eq!(
-                    plain.step(&scene),
+                    plain.step(scene),
                     Progress::Searching { evaluated },
                     "{rig}: nothing spent elsewhere is the plain step"
                 );
             }
         }
-    }
+    });
 }
 
 /// `rig` at `seed` (34 frames, 320×240) searched from nothing by the status machine under
