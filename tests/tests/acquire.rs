@@ -5,7 +5,7 @@
 //! says it acquires (docs/recovery.md: `acquire_probe --seeds 101..=140`).
 
 use digiteyes_core::acquire::{
-    AcquireConfig, Finder, FinderConfig, FinderStep, FingerPose, Progress, POSE_COUNT,
+    AcceptConfig, AcquireConfig, Finder, FinderConfig, FinderStep, FingerPose, Progress, POSE_COUNT,
 };
 use digiteyes_core::auto_tracker::Status;
 use digiteyes_core::config::MAX_STATES;
@@ -222,6 +222,48 @@ fn a_step_after_evaluations_spent_elsewhere_spends_only_what_is_left() {
                 );
             }
         }
+    });
+}
+
+#[test]
+fn a_frame_of_leaves_after_work_elsewhere_refines_one_leaf_fewer() {
+    on_first_frames(|rig, sequence, scene| {
+        // The whole search on the first step; no leaf ever accepted, so each is counted.
+        let acquire = AcquireConfig {
+            evaluations_per_frame: u16::MAX,
+            ..AcquireConfig::default()
+        };
+        let config = FinderConfig {
+            accept: AcceptConfig {
+                min_score: 2.0,
+                min_camera_score: 2.0,
+                one_camera_score: 2.0,
+            },
+            ..FinderConfig::default()
+        };
+        let refined_after = |spent: u16| {
+            let (mut tracker, mut finder) = finder(sequence, acquire, config);
+            let (views, maps) = (scene.frames, scene.edges);
+            let mut refined = Vec::new();
+            for _ in 0..3 {
+                match finder.step_after(&mut tracker, views, maps, spent).unwrap() {
+                    FinderStep::Searching { refined: n, .. } => refined.push(n),
+                    FinderStep::Found { .. } => panic!("{rig}: a leaf accepted over the bar"),
+                }
+            }
+            refined
+        };
+        let per_frame = config.leaves_per_frame;
+        assert_eq!(
+            refined_after(0),
+            vec![0, per_frame, per_frame],
+            "{rig}: the search, then its leaves"
+        );
+        assert_eq!(
+            refined_after(20),
+            vec![0, per_frame - 1, per_frame - 1],
+            "{rig}: work spent elsewhere takes one leaf's place"
+        );
     });
 }
 

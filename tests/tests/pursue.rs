@@ -1,7 +1,8 @@
 //! With one camera, a leaf of the global search that the acceptance refuses but that scores
 //! at least `FinderConfig::pursue_score` is pursued: refined again on the next
 //! `FinderConfig::pursue_frames` searching frames, beside the search (which spends that much
-//! less of its budget), and judged by the same acceptance each time. On these mono seeds the
+//! less of its budget, or refines one leaf fewer), and judged by the same acceptance each
+//! time. On these mono seeds the
 //! search's leaves come within a few pixels of the hand but score under the one-camera bar on
 //! the frame they are refined on (`acquire_probe --trace`); refined again on the next frames
 //! one of them reaches the bar, and the hand is acquired where without the pursuit the first

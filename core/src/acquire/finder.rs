@@ -374,8 +374,9 @@ impl Finder {
     }
 
     /// [`Finder::step`] on a frame that has already spent `spent` evaluations of the
-    /// search's budget elsewhere ([`Acquirer::step_after`]; a frame of leaves refines its
-    /// leaves whatever was spent).
+    /// search's budget elsewhere: the search spends only what is left
+    /// ([`Acquirer::step_after`]), and a frame of leaves refines one leaf fewer (at least
+    /// one) when anything was spent.
     pub fn step_after(
         &mut self,
         tracker: &mut Tracker,
@@ -411,7 +412,14 @@ impl Finder {
         }
         let n = tracker.model().n_states().min(MAX_STATES);
         let mut refined_now: Vec<(Verdict, [f32; MAX_STATES], FrameReport), MAX_KEEP> = Vec::new();
-        while refined_now.len() < usize::from(self.config.leaves_per_frame.max(1)) {
+        // Work spent elsewhere on this frame takes one leaf's place (at least one is refined).
+        let most = self
+            .config
+            .leaves_per_frame
+            .max(1)
+            .saturating_sub(u8::from(spent > 0))
+            .max(1);
+        while refined_now.len() < usize::from(most) {
             let Some(mut leaf) = self.leaves.pop() else {
                 break;
             };
