@@ -35,6 +35,10 @@ pub const DROPPED_COLUMN: &str = "dropped";
 /// The column after it: the board's status for the frame (`Status::as_str`'s words).
 pub use crate::sequence::status::STATUS_COLUMN;
 
+/// The last column: the board's own measure of its work on the frame, in ticks of its clock
+/// (`State::track_ticks`, `Hello::clock_hz` ticks a second); empty for a dropped frame.
+pub const BOARD_TICKS_COLUMN: &str = "board_ticks";
+
 /// The default line speed (bits/s).
 pub const DEFAULT_BAUD: u32 = 115_200;
 
@@ -371,7 +375,7 @@ fn run(
     let mut writer = StatesWriter::with_columns(
         out_csv,
         sequence.n_states(),
-        &[DROPPED_COLUMN, STATUS_COLUMN],
+        &[DROPPED_COLUMN, STATUS_COLUMN, BOARD_TICKS_COLUMN],
     )?;
     let bar = crate::progress::bar(expected, "stream", options.progress);
     let mut last: Vec<f32> = sequence.initial_state.iter().map(|&v| v as f32).collect();
@@ -394,7 +398,8 @@ fn run(
                 last.copy_from_slice(&state.q);
                 rms_sum += f64::from(state.rms_px);
                 let status = Status::from(state.status).as_str();
-                writer.write_with(&last, &report_of(state), &["", status])?;
+                let ticks = state.track_ticks.to_string();
+                writer.write_with(&last, &report_of(state), &["", status, &ticks])?;
             }
             FrameOutcome::Dropped(cause) => {
                 let report = FrameReport {
@@ -403,7 +408,7 @@ fn run(
                     ..FrameReport::default()
                 };
                 let lost = Status::Lost.as_str();
-                writer.write_with(&last, &report, &[&cause.to_string(), lost])?;
+                writer.write_with(&last, &report, &[&cause.to_string(), lost, ""])?;
             }
         }
         outcomes.push(outcome);

@@ -300,10 +300,15 @@ fn sim_then_stream_then_eval_from_the_command_line() {
             .lines()
             .next()
             .unwrap()
-            .ends_with(",lost,dropped,status"),
+            .ends_with(",lost,dropped,status,board_ticks"),
         "{states}"
     );
     assert_eq!(states.lines().count(), 4);
+    // Every tracked frame carries the board's own count of its work.
+    for row in states.lines().skip(1) {
+        let ticks: u64 = row.rsplit(',').next().unwrap().parse().expect(row);
+        assert!(ticks > 0, "{row}");
+    }
     let out = digiteyes(&["eval", "mouse", "s.csv"], dir.path());
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(text(&out.stdout).contains("track life"));

@@ -24,7 +24,8 @@ use crate::stream::{stream_camera, stream_sequence, StreamOptions, DEFAULT_BAUD}
 /// superseded, tracker error, no reply (timeout), board restarted) — its row repeats the
 /// last state with lost = 1 — and then a column `status`: what the board claimed of the
 /// frame, searching, tracking or lost (lost for a dropped frame; lost = 1 on every row
-/// that is not tracking). With --init auto the board searches for the hand instead of
+/// that is not tracking) — and last `board_ticks`: the board's own count of its work on
+/// the frame, in ticks of its clock (empty for a dropped frame). With --init auto the board searches for the hand instead of
 /// starting from initial_state; either way it searches again after losing the hand.
 /// Prints a summary (with the statuses) and the link's figures (states/s, bytes,
 /// CRC/framing errors on both ends, the board's drops by reason). A board tracks one
