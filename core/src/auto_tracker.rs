@@ -53,7 +53,7 @@ use crate::config::{MAX_CAMERAS, MAX_HYPOTHESES, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
 use crate::hypotheses::{HypothesesConfig, Hypothesis, MultiReport, MultiTracker};
-use crate::likelihood::{EdgeMap, LikelihoodConfig, LikelihoodError, Scene};
+use crate::likelihood::{BuiltEdges, EdgeMap, LikelihoodConfig, LikelihoodError, Scene};
 use crate::model::Model;
 use crate::motion::PriorWeights;
 pub use crate::status::Status;
@@ -249,12 +249,33 @@ fn edge_maps<'b>(
     frames: &[FrameView<'_>],
     likelihood: &LikelihoodConfig,
 ) -> Result<Vec<EdgeMap<'b>, MAX_CAMERAS>, AutoError> {
+    reopened_edge_maps(edge_buffers, frames, likelihood, &[])
+}
+
+/// The same, opening again the maps `built` on this frame already ([`MultiTracker::take_built_edges`]:
+/// `edge_buffers` untouched since) instead of building them a second time, when they are
+/// one per camera and of these frames' sizes under `likelihood`.
+fn reopened_edge_maps<'b>(
+    edge_buffers: &'b mut [&mut [u8]],
+    frames: &[FrameView<'_>],
+    likelihood: &LikelihoodConfig,
+    built: &[BuiltEdges],
+) -> Result<Vec<EdgeMap<'b>, MAX_CAMERAS>, AutoError> {
     if edge_buffers.len() < frames.len() {
         return Err(AutoError::BufferCount);
     }
+    let reuse = built.len() == frames.len()
+        && built
+            .iter()
+            .zip(frames)
+            .all(|(b, frame)| b.fits(frame, likelihood));
     let mut maps = Vec::new();
-    for (buffer, frame) in edge_buffers.iter_mut().zip(frames) {
-        let map = EdgeMap::build(buffer, frame, likelihood).map_err(AutoError::EdgeMap)?;
+    for (k, (buffer, frame)) in edge_buffers.iter_mut().zip(frames).enumerate() {
+        let map = match built.get(k) {
+            Some(b) if reuse => EdgeMap::reopen(buffer, *b),
+            _ => EdgeMap::build(buffer, frame, likelihood),
+        }
+        .map_err(AutoError::EdgeMap)?;
         if maps.push(map).is_err() {
             return Err(AutoError::Tracker(TrackerError::CameraCount));
         }
@@ -471,10 +492,13 @@ impl AutoTracker {
         edge_buffers: &mut [&mut [u8]],
     ) -> Result<AutoReport, AutoError> {
         let multi = self.track_hypotheses(frames, edge_buffers)?;
+        // The maps the hypotheses were scored on, if they were: each check below opens them
+        // again instead of building its own (nothing else writes the buffers this frame).
+        let built = self.multi.take_built_edges();
         let mut watch_score = None;
         if let Some(probation) = self.probation.take() {
             let confirmed = !multi.report.lost && {
-                let worst = self.worst_camera_score(frames, edge_buffers)?;
+                let worst = self.worst_camera_score(frames, edge_buffers, &built)?;
                 watch_score = Some(worst);
                 let drop = self
                     .finder
@@ -500,7 +524,7 @@ impl AutoTracker {
                 refuted = sum / (n.max(1) as f32) < self.finder.config().confirm_min_score;
                 if !refuted && !multi.report.lost && self.polish_left > 0 {
                     self.polish_left -= 1;
-                    self.polish(frames, edge_buffers)?;
+                    self.polish(frames, edge_buffers, &built)?;
                 }
             }
         }
@@ -512,7 +536,7 @@ impl AutoTracker {
         if !report.lost && self.recovery == Recovery::Search && self.watch.due() {
             let worst = match watch_score {
                 Some(worst) => worst,
-                None => self.worst_camera_score(frames, edge_buffers)?,
+                None => self.worst_camera_score(frames, edge_buffers, &built)?,
             };
             watch_score = Some(worst);
             if self.watch.judge(worst) {
@@ -585,15 +609,16 @@ impl AutoTracker {
         AutoReport::tracked(self.status, report, &multi, watch_score)
     }
 
-    /// The tracked state's likelihood score in its worst camera, each camera's edge map built
-    /// for it.
+    /// The tracked state's likelihood score in its worst camera, on each camera's edge map
+    /// (`built` on this frame already, else built for it).
     fn worst_camera_score(
         &mut self,
         frames: &[FrameView<'_>],
         edge_buffers: &mut [&mut [u8]],
+        built: &[BuiltEdges],
     ) -> Result<f32, AutoError> {
         let likelihood = self.finder.acquirer().config().likelihood;
-        let maps = edge_maps(edge_buffers, frames, &likelihood)?;
+        let maps = reopened_edge_maps(edge_buffers, frames, &likelihood, built)?;
         let tracker = self.multi.tracker();
         let q = padded(tracker.state());
         let scene = Scene::new(tracker.model(), tracker.cameras(), frames, &maps);
@@ -690,13 +715,14 @@ impl AutoTracker {
         &mut self,
         frames: &[FrameView<'_>],
         edge_buffers: &mut [&mut [u8]],
+        built: &[BuiltEdges],
     ) -> Result<(), AutoError> {
         let n_cameras = self.multi.tracker().cameras().len();
         let Some(margin) = self.finder.config().polish(n_cameras) else {
             return Ok(());
         };
         let likelihood = self.finder.acquirer().config().likelihood;
-        let maps = edge_maps(edge_buffers, frames, &likelihood)?;
+        let maps = reopened_edge_maps(edge_buffers, frames, &likelihood, built)?;
         let tracker = self.multi.tracker();
         let q = padded(tracker.state());
         let scene = Scene::new(tracker.model(), tracker.cameras(), frames, &maps);

@@ -33,7 +33,7 @@ use crate::auto_tracker::AutoError;
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_CANDIDATES, MAX_HYPOTHESES};
 use crate::frame::FrameView;
-use crate::likelihood::{EdgeMap, Scene};
+use crate::likelihood::{BuiltEdges, EdgeMap, Scene};
 use crate::state::{clamp_to_limit, renormalise_quaternion};
 use crate::tracker::{FrameReport, TrackMemory, Tracker, TrackerError};
 use score::StateScorer;
@@ -96,6 +96,9 @@ pub struct MultiTracker {
     fingers: fingers::Fingers,
     /// Frames tracked since the last scored one ([`HypothesesConfig::score_every_frames`]).
     since_scored: u8,
+    /// The edge maps the last [`MultiTracker::track`] built into the caller's buffers, one
+    /// per camera (empty when it built none): [`MultiTracker::take_built_edges`].
+    built: Vec<BuiltEdges, MAX_CAMERAS>,
 }
 
 impl MultiTracker {
@@ -111,7 +114,16 @@ impl MultiTracker {
             scorer: StateScorer::new(),
             fingers,
             since_scored: 0,
+            built: Vec::new(),
         }
+    }
+
+    /// The edge maps the last [`MultiTracker::track`] built into its `edge_buffers`, one per
+    /// camera, to open again with [`EdgeMap::reopen`] while those buffers are untouched (the
+    /// rest of the same frame's step); empty when it built none (one hypothesis, or a frame
+    /// not scored). Taken: a second call returns none.
+    pub fn take_built_edges(&mut self) -> Vec<BuiltEdges, MAX_CAMERAS> {
+        core::mem::take(&mut self.built)
     }
 
     /// The hypotheses carried, best first.
@@ -203,6 +215,7 @@ impl MultiTracker {
         frames: &[FrameView<'_>],
         edge_buffers: &mut [&mut [u8]],
     ) -> Result<MultiReport, AutoError> {
+        self.built.clear();
         if self.config.count() == 1 {
             let report = self.tracker.track(frames)?;
             if let Some(h) = self.hypotheses.first_mut() {
@@ -229,9 +242,12 @@ impl MultiTracker {
         let mut maps: Vec<EdgeMap<'_>, MAX_CAMERAS> = Vec::new();
         for (buffer, frame) in edge_buffers.iter_mut().zip(frames) {
             let map = EdgeMap::build(buffer, frame, &likelihood).map_err(AutoError::EdgeMap)?;
+            let built = map.built(frame, &likelihood);
             if maps.push(map).is_err() {
                 return Err(AutoError::Tracker(TrackerError::CameraCount));
             }
+            // As many as `maps` holds, so never full here.
+            let _ = self.built.push(built);
         }
         let mut candidates: Vec<Hypothesis, MAX_CANDIDATES> = Vec::new();
         let n = self.tracker.model().n_states();

@@ -49,6 +49,31 @@ pub(crate) fn bin_of(angle: f32) -> (usize, usize) {
     (nearest, second)
 }
 
+/// What a built [`EdgeMap`] holds besides its buffer's bytes: enough to open the same map
+/// again from that buffer ([`EdgeMap::reopen`]) without building it a second time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BuiltEdges {
+    width: usize,
+    height: usize,
+    min_gradient: f32,
+    cols: usize,
+    rows: usize,
+    stride_px: usize,
+    edge_cells: u32,
+    region: Option<Region>,
+}
+
+impl BuiltEdges {
+    /// Whether this is the map [`EdgeMap::build`] makes of a frame of `frame`'s size under
+    /// `config` (the size and the parameters the build used; not the pixels).
+    pub fn fits(&self, frame: &FrameView<'_>, config: &LikelihoodConfig) -> bool {
+        self.width == frame.width()
+            && self.height == frame.height()
+            && self.stride_px == usize::from(config.stride_px)
+            && self.min_gradient.to_bits() == config.min_gradient.to_bits()
+    }
+}
+
 /// A frame's edges as per-orientation distance maps on a coarse grid, in a caller's buffer.
 #[derive(Debug)]
 pub struct EdgeMap<'b> {
@@ -105,6 +130,42 @@ impl<'b> EdgeMap<'b> {
             map.transform(bin);
         }
         Ok(map)
+    }
+
+    /// What opens this map again from its buffer ([`EdgeMap::reopen`]), given the frame and
+    /// the parameters it was built from ([`EdgeMap::build`]'s).
+    pub fn built(&self, frame: &FrameView<'_>, config: &LikelihoodConfig) -> BuiltEdges {
+        BuiltEdges {
+            width: frame.width(),
+            height: frame.height(),
+            min_gradient: config.min_gradient,
+            cols: self.cols,
+            rows: self.rows,
+            stride_px: self.stride_px,
+            edge_cells: self.edge_cells,
+            region: self.region,
+        }
+    }
+
+    /// The map `built` describes, from the buffer it was built in, as it was: the caller
+    /// vouches that `buffer` has not been written since ([`EdgeMap::built`] on the same frame).
+    /// A scorer that needs the frame's map twice saves the second build (3.2 M instructions
+    /// for a 320×240 frame). Fails only when `buffer` is too small for `built`'s cells.
+    pub fn reopen(buffer: &'b mut [u8], built: BuiltEdges) -> Result<Self, LikelihoodError> {
+        let needed = built.cols * built.rows * EDGE_BINS;
+        let Some(dist) = buffer.get_mut(..needed) else {
+            return Err(LikelihoodError::BufferTooSmall {
+                needed: u32::try_from(needed).unwrap_or(u32::MAX),
+            });
+        };
+        Ok(EdgeMap {
+            dist,
+            cols: built.cols,
+            rows: built.rows,
+            stride_px: built.stride_px,
+            edge_cells: built.edge_cells,
+            region: built.region,
+        })
     }
 
     /// Cells across and down.
@@ -220,58 +281,66 @@ impl<'b> EdgeMap<'b> {
     }
 }
 
-/// One row of a chamfer pass: `row` relaxed from its neighbour along the pass (`dir` = 1:
-/// left to right, from `other`, the row above; −1: right to left, from the row below).
+/// One row of a chamfer pass: each cell relaxed from the three cells of `other` (the row the
+/// pass comes from: above for `dir` = 1, below for −1) beside it, then along the row from
+/// the side the pass starts (`dir` = 1: left to right; −1: right to left). The 3-4 mask's
+/// cells in the other row are the same either way (4, 3, 4), so only the run along the row
+/// turns round. Every value stays ≤ [`FAR`].
 #[inline]
 fn relax_row(row: &mut [u8], other: &[u8], dir: i32) {
+    relax_across(row, other);
     if dir > 0 {
-        relax_forward(row, other);
+        relax_along(row.iter_mut());
     } else {
-        row.reverse();
-        // The other row reversed on the fly: the same pass, mirrored.
-        let mut mirrored = [FAR; MAX_PASS_CELLS];
-        let m = other.len().min(MAX_PASS_CELLS);
-        for (d, s) in mirrored.iter_mut().zip(other.iter().take(m).rev()) {
-            *d = *s;
-        }
-        relax_forward(row, mirrored.get(..m).unwrap_or(&[]));
-        row.reverse();
+        relax_along(row.iter_mut().rev());
     }
 }
 
-/// Cells of a row the mirrored pass handles with the row above or below (wider rows are
-/// relaxed along the row only).
-const MAX_PASS_CELLS: usize = 512;
-
-/// Left to right: each cell from the three cells of `other` above it (independent per
-/// cell), then from its left neighbour (a running minimum). Every value stays ≤ [`FAR`].
+/// Each cell from the three cells of `other` beside it (3 straight across, 4 diagonally),
+/// independent per cell; nothing when `other` is not as long as `row` (the first row of a
+/// pass).
 #[inline]
-fn relax_forward(row: &mut [u8], other: &[u8]) {
+fn relax_across(row: &mut [u8], other: &[u8]) {
     let n = row.len();
-    if other.len() == n && n > 1 {
-        if let (Some(first), Some(&o0), Some(&o1)) = (row.first_mut(), other.first(), other.get(1))
-        {
-            *first = (*first).min(o0 + 3).min(o1 + 4);
-        }
-        for (d, w) in row.iter_mut().skip(1).zip(other.windows(3)) {
-            let (ul, u, ur) = (w[0], w[1], w[2]);
-            *d = (*d).min(u + 3).min((ul + 4).min(ur + 4));
-        }
-        if let (Some(last), Some(&ol), Some(&o)) =
-            (row.last_mut(), other.get(n - 2), other.get(n - 1))
-        {
-            *last = (*last).min(o + 3).min(ol + 4);
-        }
-    } else if other.len() == n {
+    if other.len() != n {
+        return;
+    }
+    if n < 2 {
         for (d, o) in row.iter_mut().zip(other) {
             *d = (*d).min(o + 3);
         }
+        return;
     }
-    let mut left = FAR;
-    for v in row.iter_mut() {
-        let d = (*v).min(left + 3).min(FAR);
+    if let (Some(first), Some(&o0), Some(&o1)) = (row.first_mut(), other.first(), other.get(1)) {
+        *first = (*first).min(o0 + 3).min(o1 + 4);
+    }
+    if let (Some(last), Some(&ol), Some(&o)) = (row.last_mut(), other.get(n - 2), other.get(n - 1))
+    {
+        *last = (*last).min(o + 3).min(ol + 4);
+    }
+    // Inner cells against three equally long views of `other` (its cells before, across and
+    // after each): plain slices, which the compiler turns into vector code.
+    let (Some(inner), Some(before), Some(across), Some(after)) = (
+        row.get_mut(1..n - 1),
+        other.get(..n - 2),
+        other.get(1..n - 1),
+        other.get(2..),
+    ) else {
+        return;
+    };
+    for (((d, &a), &b), &c) in inner.iter_mut().zip(before).zip(across).zip(after) {
+        *d = (*d).min(b + 3).min((a + 4).min(c + 4));
+    }
+}
+
+/// A running minimum along `cells`, in the order given: each cell from the one before (3).
+#[inline]
+fn relax_along<'a>(cells: impl Iterator<Item = &'a mut u8>) {
+    let mut before = FAR;
+    for v in cells {
+        let d = (*v).min(before + 3).min(FAR);
         *v = d;
-        left = d;
+        before = d;
     }
 }
 
@@ -314,5 +383,93 @@ mod tests {
         let region = map.region.unwrap();
         assert!((region.centre_px.x - 31.5).abs() < 3.0, "{region:?}");
         assert!((region.centre_px.y - 23.5).abs() < 3.0, "{region:?}");
+    }
+
+    #[test]
+    fn the_two_passes_give_the_exact_3_4_chamfer_distance() {
+        // Against the distance itself: 3 a cell straight, 4 diagonally, so 3·max + min of the
+        // cell offsets to the nearest edge cell, held at FAR.
+        let mut seed = 12345u32;
+        let mut next = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            seed >> 8
+        };
+        for (cols, rows, edges) in [(1, 5, 1), (5, 1, 1), (2, 2, 1), (37, 23, 6), (90, 4, 2)] {
+            let mut dist = [FAR; 90 * 23];
+            let mut marked = [(0usize, 0usize); 6];
+            for m in marked.iter_mut().take(edges) {
+                *m = (next() as usize % cols, next() as usize % rows);
+                dist[m.1 * cols + m.0] = 0;
+            }
+            let mut map = EdgeMap {
+                dist: &mut dist[..cols * rows],
+                cols,
+                rows,
+                stride_px: 4,
+                edge_cells: edges as u32,
+                region: None,
+            };
+            map.transform(0);
+            for y in 0..rows {
+                for x in 0..cols {
+                    let exact = marked[..edges]
+                        .iter()
+                        .map(|&(ex, ey)| {
+                            let (dx, dy) = (x.abs_diff(ex), y.abs_diff(ey));
+                            3 * dx.max(dy) + dx.min(dy)
+                        })
+                        .min()
+                        .unwrap()
+                        .min(usize::from(FAR));
+                    assert_eq!(
+                        usize::from(map.dist[y * cols + x]),
+                        exact,
+                        "{cols}x{rows} at ({x}, {y})"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_map_reopened_from_its_buffer_is_the_map_built() {
+        let (w, h) = (64usize, 48usize);
+        let mut pixels = [20u8; 64 * 48];
+        for y in 10..30 {
+            for x in 12..40 {
+                pixels[y * w + x] = 180;
+            }
+        }
+        let frame = FrameView::packed(&pixels, w, h).unwrap();
+        let config = LikelihoodConfig::default();
+        let mut buffer = [0u8; 16 * 12 * EDGE_BINS];
+        let (built, distances) = {
+            let map = EdgeMap::build(&mut buffer, &frame, &config).unwrap();
+            let d: [Option<f32>; 4] = core::array::from_fn(|k| {
+                map.distance_px(k % EDGE_BINS, &Vector2::new(5.0 + 13.0 * k as f32, 20.0))
+            });
+            (map.built(&frame, &config), d)
+        };
+        assert!(built.fits(&frame, &config));
+        let again = EdgeMap::reopen(&mut buffer, built).unwrap();
+        assert_eq!(again.built(&frame, &config), built);
+        assert_eq!(again.region, built.region);
+        for (k, d) in distances.iter().enumerate() {
+            let p = Vector2::new(5.0 + 13.0 * k as f32, 20.0);
+            assert_eq!(again.distance_px(k % EDGE_BINS, &p), *d);
+        }
+        // Another size or another threshold is another map; a short buffer is an error.
+        let small = FrameView::packed(&pixels[..64 * 40], 64, 40).unwrap();
+        assert!(!built.fits(&small, &config));
+        let other = LikelihoodConfig {
+            min_gradient: config.min_gradient + 1.0,
+            ..config
+        };
+        assert!(!built.fits(&frame, &other));
+        let mut short = [0u8; 10];
+        assert!(matches!(
+            EdgeMap::reopen(&mut short, built),
+            Err(LikelihoodError::BufferTooSmall { .. })
+        ));
     }
 }

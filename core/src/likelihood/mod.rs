@@ -21,7 +21,7 @@ mod samples;
 mod scene;
 mod state;
 
-pub use edges::{EdgeMap, EDGE_BINS, GRADIENT_STEP_PX};
+pub use edges::{BuiltEdges, EdgeMap, EDGE_BINS, GRADIENT_STEP_PX};
 pub use region::{Region, EXTENT_PERCENTILE, MAX_EXTENT_BINS, MIN_REGION_SAMPLES};
 use samples::ChamferSum;
 pub use samples::{visit, Samples, SilhouettePoint, MAX_SAMPLES, MAX_SAMPLES_PER_LINE};
