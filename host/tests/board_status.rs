@@ -85,19 +85,24 @@ fn stream_init_auto_has_a_simulated_board_search_and_writes_the_status() {
     let csv = std::fs::read_to_string(dir.path().join("s.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    assert_eq!(&header[header.len() - 3..], ["lost", "dropped", "status"]);
+    assert_eq!(
+        &header[header.len() - 4..],
+        ["lost", "dropped", "status", "board_ticks"]
+    );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 3);
+    // lost, dropped, status and the board's ticks of each row.
+    let tail = |row: &[&str]| -> [String; 4] {
+        core::array::from_fn(|k| row[row.len() - 4 + k].to_string())
+    };
     // The first frame of a search can only search; later ones may have found the hand.
-    assert_eq!(&rows[0][rows[0].len() - 3..], ["1", "", "searching"]);
+    assert_eq!(&tail(&rows[0])[..3], ["1", "", "searching"]);
     for row in &rows {
-        let tail = &row[row.len() - 3..];
-        assert_eq!(tail[0] == "1", tail[2] != "tracking", "{row:?}");
+        let [lost, _, status, ticks] = tail(row);
+        assert_eq!(lost == "1", status != "tracking", "{row:?}");
+        assert!(ticks.parse::<u32>().is_ok_and(|t| t > 0), "{row:?}");
     }
-    let searching = rows
-        .iter()
-        .filter(|r| r.last() == Some(&"searching"))
-        .count();
+    let searching = rows.iter().filter(|r| tail(r)[2] == "searching").count();
     assert!(
         stdout.contains(&format!("{searching} searching")),
         "the summary counts the statuses: {stdout}"
@@ -120,7 +125,9 @@ fn stream_init_auto_has_a_simulated_board_search_and_writes_the_status() {
     );
     let csv = std::fs::read_to_string(dir.path().join("given.csv")).unwrap();
     assert!(
-        csv.lines().skip(1).all(|l| l.ends_with(",0,,tracking")),
+        csv.lines().skip(1).all(|l| l
+            .rsplit_once(',')
+            .is_some_and(|(head, _)| head.ends_with(",0,,tracking"))),
         "{csv}"
     );
 }
