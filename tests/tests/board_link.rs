@@ -7,9 +7,11 @@ use std::time::Duration;
 
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::protocol::{DropReason, Start, WireStatus};
+use digiteyes_host::acquire::Status;
 use digiteyes_host::link::{DropCause, FrameOutcome, Link, Session, SessionSetup};
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::sim::{Corruption, SimBoard, SimOptions, SimReport, Window};
+use digiteyes_host::track::{sequence_auto_tracker, Init, TrackOptions};
 use digiteyes_host::{
     render_scenario, sequence_tracker, stream_sequence, RenderOptions, StreamOptions,
     StreamSummary, TrackerConfig,
@@ -190,6 +192,70 @@ fn a_board_power_cycle_mid_sequence_is_followed() {
     }
     // The rebooted board counted from its boot: the frames after the restart.
     assert_eq!(summary.link.board.unwrap().frames, 4);
+}
+
+/// A board finds the hand from nothing, loses it while the camera sees no hand, and finds it
+/// again once it is back — state for state and status for status what `digiteyes track
+/// --init auto` does in process (the same status machine, search and budget).
+#[test]
+fn a_board_finds_the_hand_loses_it_in_a_blackout_and_finds_it_again_as_the_host_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("mouse");
+    let (dark, n) = (30..50, 70);
+    let options = RenderOptions {
+        frames: Some(n),
+        size: Some((320, 240)),
+        supersample: 2,
+        blackout: Some(dark.clone()),
+        ..RenderOptions::default()
+    };
+    render_scenario("mouse", &seq, &options).unwrap();
+    let board = SimBoard::start(SimOptions::default()).unwrap();
+    let out = seq.join("board-states.csv");
+    let stream = StreamOptions::new(board.path().display().to_string())
+        .reply_timeout(Duration::from_secs(10))
+        .start(Some(Start::Search));
+    let summary = stream_sequence(&seq, &out, &stream).unwrap();
+    board.stop().unwrap();
+
+    let sequence = Sequence::open(&seq).unwrap();
+    let track = TrackOptions {
+        init: Some(Init::Auto),
+        ..TrackOptions::default()
+    };
+    let mut host = sequence_auto_tracker(&sequence, TrackerConfig::default(), &track).unwrap();
+    let mut statuses = String::new();
+    for (k, outcome) in summary.outcomes.iter().enumerate() {
+        let image = sequence.read_frame(0, k).unwrap();
+        let view = FrameView::packed(
+            image.as_raw(),
+            image.width() as usize,
+            image.height() as usize,
+        )
+        .unwrap();
+        let expected = host.step(&[view]).unwrap();
+        let FrameOutcome::Tracked(state) = outcome else {
+            panic!("frame {k} not answered by the board: {outcome:?}");
+        };
+        assert_eq!(Status::from(state.status), expected.status, "frame {k}");
+        let bits = |q: &[f32]| q.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&state.q), bits(host.state()), "frame {k}");
+        statuses.push_str(&expected.status.as_str()[..1]);
+    }
+    // Found from nothing, lost in the dark (and searched for), found again after it.
+    let first = statuses.find('t').expect("never acquired");
+    assert!(first < 10, "acquired at frame {first}: {statuses}");
+    assert!(
+        statuses[dark.clone()].chars().all(|c| c != 't'),
+        "a hand claimed in the dark: {statuses}"
+    );
+    assert!(statuses[dark.clone()].contains('s'), "{statuses}");
+    let back = statuses[dark.end..].find('t').expect("never re-acquired") + dark.end;
+    assert!(
+        back < dark.end + 10,
+        "re-acquired at frame {back}: {statuses}"
+    );
+    assert!(statuses[back..].chars().all(|c| c == 't'), "{statuses}");
 }
 
 /// A board that was searching when it rebooted is set up to search again (not to track the

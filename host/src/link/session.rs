@@ -306,6 +306,11 @@ impl Session {
             hypotheses: self.setup.hypotheses,
         });
         self.command(&configure, Command::Configure)?;
+        // A search starts from the same base as the host's own (`track --init auto`).
+        let q = match start {
+            Start::Search => &self.setup.search_base[..],
+            Start::Given => q,
+        };
         let q: HVec<f32, MAX_STATES> = q.iter().copied().take(MAX_STATES).collect();
         let reset = HostMessage::Reset(Reset {
             q,

@@ -27,6 +27,11 @@ pub struct SessionSetup {
     pub stats_every: u16,
     /// The state at the first frame (`Reset`): quaternion, mm, rad.
     pub initial_state: Vec<f32>,
+    /// What a search starts from (`Reset` with [`Start::Search`]): the fixed states'
+    /// `initial_state` values and the free states' neutral base
+    /// ([`Sequence::search_base`]), as `digiteyes track --init auto` starts: the free
+    /// states' given values are ignored.
+    pub search_base: Vec<f32>,
     /// Bit `i`: state `i` is estimated (`Reset`).
     pub free: u32,
     /// How the board starts (`Reset`): tracking from `initial_state`, or searching for the
@@ -84,6 +89,7 @@ impl SessionSetup {
             features_every: 0,
             stats_every: 0,
             initial_state: sequence.initial_state.iter().map(|&v| v as f32).collect(),
+            search_base: sequence.search_base().iter().map(|&v| v as f32).collect(),
             free,
             // A sequence without an initial state can only be searched for.
             start: if sequence.initial_given {
