@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use digiteyes_core::frame::FrameView;
-use digiteyes_core::protocol::{DropReason, Start, WireStatus};
+use digiteyes_core::protocol::{DropReason, Start, State, WireStatus};
 use digiteyes_host::acquire::Status;
 use digiteyes_host::link::{DropCause, FrameOutcome, Link, Session, SessionSetup};
 use digiteyes_host::sequence::Sequence;
@@ -39,6 +39,32 @@ fn tracked(outcome: &FrameOutcome) -> bool {
     matches!(outcome, FrameOutcome::Tracked(_))
 }
 
+/// Calls `f` with each frame's number, the frame as the in-process tracker reads it, and the
+/// board's `State` for it; fails on a frame the board did not answer with one.
+fn each_answered(
+    sequence: &Sequence,
+    summary: &StreamSummary,
+    mut f: impl FnMut(usize, FrameView<'_>, &State),
+) {
+    for (k, outcome) in summary.outcomes.iter().enumerate() {
+        let image = sequence.read_frame(0, k).unwrap();
+        let view = FrameView::packed(
+            image.as_raw(),
+            image.width() as usize,
+            image.height() as usize,
+        )
+        .unwrap();
+        let FrameOutcome::Tracked(state) = outcome else {
+            panic!("frame {k} not answered by the board: {outcome:?}");
+        };
+        f(k, view, state);
+    }
+}
+
+fn bits(q: &[f32]) -> Vec<u32> {
+    q.iter().map(|v| v.to_bits()).collect()
+}
+
 #[test]
 fn states_over_the_link_equal_the_in_process_tracker() {
     let dir = tempfile::tempdir().unwrap();
@@ -49,20 +75,9 @@ fn states_over_the_link_equal_the_in_process_tracker() {
     // The in-process tracker, exactly as `digiteyes track` sets it up.
     let sequence = Sequence::open(&seq).unwrap();
     let mut tracker = sequence_tracker(&sequence, TrackerConfig::default()).unwrap();
-    for (k, outcome) in summary.outcomes.iter().enumerate() {
-        let image = sequence.read_frame(0, k).unwrap();
-        let view = FrameView::packed(
-            image.as_raw(),
-            image.width() as usize,
-            image.height() as usize,
-        )
-        .unwrap();
+    each_answered(&sequence, &summary, |k, view, state| {
         let report = tracker.track(&[view]).unwrap();
-        let FrameOutcome::Tracked(state) = outcome else {
-            panic!("frame {k} not tracked on the board: {outcome:?}");
-        };
         assert_eq!(state.frame, k as u32);
-        let bits = |q: &[f32]| q.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!(
             bits(&state.q),
             bits(tracker.state()),
@@ -86,7 +101,7 @@ fn states_over_the_link_equal_the_in_process_tracker() {
             ),
             "frame {k}"
         );
-    }
+    });
     let link = &summary.link;
     assert!(link.pong, "the final ping was answered");
     assert_eq!(link.host_link.crc_errors + link.host_link.framing_errors, 0);
@@ -225,23 +240,12 @@ fn a_board_finds_the_hand_loses_it_in_a_blackout_and_finds_it_again_as_the_host_
     };
     let mut host = sequence_auto_tracker(&sequence, TrackerConfig::default(), &track).unwrap();
     let mut statuses = String::new();
-    for (k, outcome) in summary.outcomes.iter().enumerate() {
-        let image = sequence.read_frame(0, k).unwrap();
-        let view = FrameView::packed(
-            image.as_raw(),
-            image.width() as usize,
-            image.height() as usize,
-        )
-        .unwrap();
+    each_answered(&sequence, &summary, |k, view, state| {
         let expected = host.step(&[view]).unwrap();
-        let FrameOutcome::Tracked(state) = outcome else {
-            panic!("frame {k} not answered by the board: {outcome:?}");
-        };
         assert_eq!(Status::from(state.status), expected.status, "frame {k}");
-        let bits = |q: &[f32]| q.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&state.q), bits(host.state()), "frame {k}");
         statuses.push_str(&expected.status.as_str()[..1]);
-    }
+    });
     // Found from nothing, lost in the dark (and searched for), found again after it.
     let first = statuses.find('t').expect("never acquired");
     assert!(first < 10, "acquired at frame {first}: {statuses}");
