@@ -12,10 +12,11 @@
 //! re-acquisition's palm turn (rad); `probation` the acceptance's probation drop, negative:
 //! off; `budget` the search's evaluations a frame and camera; `pursue1` the searching frames
 //! one camera pursues a refused leaf, 0: never). Each group's row also gives its frames far from the hand and not flagged (`far`)
-//! and the lost flag's precision and recall (`lostP`, `lostR`), as the benchmark counts them.
+//! and the lost flag's precision and recall (`lostP`, `lostR`), as the benchmark counts them,
+//! and the median share of frames held (`held50`, as `eval`'s frames held).
 //! Every variant after the first is also compared with the first seed by seed (paired):
 //! the mean change of track life, how many seeds gained or lost more than 5 points, and the
-//! two-sided sign test's p over those (the median of 30 seeds moves by 10–20 points between
+//! two-sided sign test's p over those, and the mean change of the share of frames held (the median of 30 seeds moves by 10–20 points between
 //! sweeps by chance alone; pairing the same seeds sees far smaller effects).
 //! For trying a change quickly; the benchmark itself is the judge.
 //!
@@ -71,8 +72,8 @@ fn main() -> Result<()> {
         .filter(|(n, _)| args.parity.is_none_or(|p| n % 2 == p))
         .collect();
     seeds.sort();
-    println!("variant group seeds life50 life10 ge95 joint50 tip50 far lostP lostR lives");
-    let mut first: Option<Vec<(u64, f64)>> = None;
+    println!("variant group seeds life50 life10 ge95 held50 joint50 tip50 far lostP lostR lives");
+    let mut first: Option<Vec<Run>> = None;
     for name in &args.variants {
         let (config, options) = variant(name)?;
         let results = Mutex::new(Vec::new());
@@ -108,6 +109,7 @@ fn main() -> Result<()> {
                                 r.joint_rms_deg,
                                 tip,
                                 judged,
+                                r.held_share,
                             ))
                         }
                         Err(e) => eprintln!("seed {seed}: {e:#}"),
@@ -117,7 +119,7 @@ fn main() -> Result<()> {
         });
         let mut results = results.into_inner().unwrap();
         results.sort_by_key(|r| r.0);
-        let lives: Vec<(u64, f64)> = results.iter().map(|r| (r.0, r.1)).collect();
+        let lives: Vec<Run> = results.iter().map(|r| (r.0, r.1, r.5)).collect();
         match &first {
             None => first = Some(lives),
             Some(base) => paired(name, base, &lives),
@@ -130,6 +132,7 @@ fn main() -> Result<()> {
             let life: Vec<f64> = g.iter().map(|r| r.1).collect();
             let joint: Vec<f64> = g.iter().map(|r| r.2).collect();
             let tip: Vec<f64> = g.iter().map(|r| r.3).collect();
+            let held: Vec<f64> = g.iter().map(|r| r.5).collect();
             let ge95 = life.iter().filter(|&&l| l >= 0.95).count() as f64 / life.len() as f64;
             let far: usize = g.iter().map(|r| r.4.far_unflagged).sum();
             let both: usize = g.iter().map(|r| r.4.flagged_and_lost).sum();
@@ -142,11 +145,12 @@ fn main() -> Result<()> {
                 .map(|r| format!("{}:{:.0}", r.0, 100.0 * r.1))
                 .collect();
             println!(
-                "{name} {group} {} {:.0}% {:.0}% {:.0}% {:.2} {:.2} {far} {precision:.2} {recall:.2} {}",
+                "{name} {group} {} {:.0}% {:.0}% {:.0}% {:.0}% {:.2} {:.2} {far} {precision:.2} {recall:.2} {}",
                 g.len(),
                 100.0 * stats::percentile(&life, 0.5),
                 100.0 * stats::percentile(&life, 0.1),
                 100.0 * ge95,
+                100.0 * stats::percentile(&held, 0.5),
                 stats::percentile(&joint, 0.5),
                 stats::percentile(&tip, 0.5),
                 lives.join(" ")
@@ -156,15 +160,21 @@ fn main() -> Result<()> {
     Ok(())
 }
 
+/// One seed's run under a variant: the seed, its track life and its share of frames held.
+type Run = (u64, f64, f64);
+
 /// The seed-by-seed comparison of `lives` with `base`, per group.
-fn paired(name: &str, base: &[(u64, f64)], lives: &[(u64, f64)]) {
+fn paired(name: &str, base: &[Run], lives: &[Run]) {
     for (group, parity) in [("mono", 1), ("stereo", 0), ("all", 2)] {
         // (life before, life after) of each seed of the group.
-        let pairs: Vec<(f64, f64)> = lives
+        let matched: Vec<(&Run, &Run)> = lives
             .iter()
-            .filter(|(s, _)| parity == 2 || s % 2 == parity)
-            .filter_map(|(s, l)| base.iter().find(|(b, _)| b == s).map(|(_, b)| (*b, *l)))
+            .filter(|(s, _, _)| parity == 2 || s % 2 == parity)
+            .filter_map(|l| base.iter().find(|b| b.0 == l.0).map(|b| (b, l)))
             .collect();
+        let pairs: Vec<(f64, f64)> = matched.iter().map(|(b, l)| (b.1, l.1)).collect();
+        let held_change =
+            matched.iter().map(|(b, l)| l.2 - b.2).sum::<f64>() / matched.len().max(1) as f64;
         if pairs.is_empty() {
             continue;
         }
@@ -179,9 +189,10 @@ fn paired(name: &str, base: &[(u64, f64)], lives: &[(u64, f64)]) {
             .filter(|(b, l)| *b >= 0.95 && *l < 0.95)
             .count();
         println!(
-            "  paired {name} {group}: mean life change {:+.1} points, {better} seeds gained > 5, {worse} lost > 5, sign test p {:.3}; {rose} rose to >= 95 %, {fell} fell below",
+            "  paired {name} {group}: mean life change {:+.1} points, {better} seeds gained > 5, {worse} lost > 5, sign test p {:.3}; {rose} rose to >= 95 %, {fell} fell below; frames held {:+.1} points",
             100.0 * pairs.iter().map(|(b, l)| l - b).sum::<f64>() / pairs.len() as f64,
-            sign_test(better, worse)
+            sign_test(better, worse),
+            100.0 * held_change
         );
     }
 }

@@ -188,13 +188,39 @@ fn a_lost_track_shows_in_the_report() {
 }
 
 #[test]
+fn a_hand_found_again_ends_the_life_but_counts_as_held_again() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = small_sequence(dir.path(), "mouse", 10);
+    let truth = Sequence::open(&seq).unwrap().read_truth().unwrap().rows;
+    // The palm 150 mm off over frames 2..7, right before and after.
+    let rows: Vec<Vec<f64>> = truth
+        .iter()
+        .enumerate()
+        .map(|(k, q)| {
+            let mut q = q.clone();
+            if (2..7).contains(&k) {
+                q[4] += 150.0;
+            }
+            q
+        })
+        .collect();
+    let r = eval_rows(&seq, &rows);
+    assert_eq!(r.track_life, 2.0 / 10.0);
+    assert_eq!(r.held_share, 5.0 / 10.0);
+    let json: serde_json::Value = serde_json::to_value(&r).unwrap();
+    assert_eq!(json["held_share"], 0.5);
+}
+
+#[test]
 fn the_report_prints_as_a_table_and_as_json() {
     let dir = tempfile::tempdir().unwrap();
     let seq = small_sequence(dir.path(), "mouse", 3);
     let r = evaluate(&seq, &seq.join("truth.csv")).unwrap();
     let table = r.to_string();
     assert!(
-        table.contains("fingertip mean") && table.contains("track life"),
+        table.contains("fingertip mean")
+            && table.contains("track life")
+            && table.contains("frames held"),
         "{table}"
     );
     let json: serde_json::Value = serde_json::to_value(&r).unwrap();

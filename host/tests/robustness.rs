@@ -129,6 +129,7 @@ fn the_benchmark_runs_a_tiny_sweep() {
         assert_eq!(s.stereo, s.seed.is_multiple_of(2));
         assert_eq!(s.frames, 10);
         assert!((0.0..=1.0).contains(&s.track_life));
+        assert!((0.0..=1.0).contains(&s.held_share));
         assert!(s.lost_flagged_and_true + s.lost_flagged_only + s.lost_true_only <= 10);
         assert_eq!(s.nan_frames, 0);
         assert!(s.iterations_per_frame >= 1.0, "{s:?}");
@@ -139,7 +140,10 @@ fn the_benchmark_runs_a_tiny_sweep() {
     assert_eq!(json["seeds"].as_array().unwrap().len(), 2);
     let text = sweep.to_string();
     assert!(
-        text.contains("mono") && text.contains("stereo") && text.contains("lostP"),
+        text.contains("mono")
+            && text.contains("stereo")
+            && text.contains("lostP")
+            && text.contains("held50"),
         "{text}"
     );
 }

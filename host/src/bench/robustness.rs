@@ -108,6 +108,9 @@ pub struct SeedResult {
     pub stereo: bool,
     /// Track life (0–1), as `eval` defines it.
     pub track_life: f64,
+    /// Share of all frames held (0–1; `eval`'s frames held): the mean fingertip error within
+    /// `eval`'s threshold, also after the track life ends.
+    pub held_share: f64,
     /// Mean fingertip reprojection error over frames and cameras (px at the size rendered).
     pub fingertip_px: f64,
     /// RMS joint error (deg).
@@ -255,6 +258,7 @@ pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResu
         seed,
         stereo,
         track_life: report.track_life,
+        held_share: report.held_share,
         fingertip_px: stats::mean(
             &report
                 .cameras
@@ -388,6 +392,10 @@ pub struct Distribution {
     pub life_p10: f64,
     /// Share of seeds with track life ≥ 0.95.
     pub life_at_least_95: f64,
+    /// Median share of frames held ([`SeedResult::held_share`]).
+    pub held_median: f64,
+    /// 10th percentile of the share of frames held.
+    pub held_p10: f64,
     /// Median fingertip error (px).
     pub tip_px_median: f64,
     /// Median joint RMS (deg).
@@ -411,6 +419,7 @@ impl Distribution {
     pub fn of(seeds: &[&SeedResult]) -> Distribution {
         let pick = |f: fn(&SeedResult) -> f64| seeds.iter().map(|s| f(s)).collect::<Vec<_>>();
         let life = pick(|s| s.track_life);
+        let held = pick(|s| s.held_share);
         let confusion = seeds.iter().fold([0; 4], |mut c, s| {
             c[0] += s.lost_flagged_and_true;
             c[1] += s.lost_flagged_only;
@@ -424,6 +433,8 @@ impl Distribution {
             life_p10: stats::percentile(&life, 0.1),
             life_at_least_95: life.iter().filter(|&&l| l >= 0.95).count() as f64
                 / life.len().max(1) as f64,
+            held_median: stats::percentile(&held, 0.5),
+            held_p10: stats::percentile(&held, 0.1),
             tip_px_median: stats::percentile(&pick(|s| s.fingertip_px), 0.5),
             joint_deg_median: stats::percentile(&pick(|s| s.joint_rms_deg), 0.5),
             palm_deg_median: stats::percentile(&pick(|s| s.palm_deg), 0.5),
@@ -469,12 +480,14 @@ impl fmt::Display for Sweep {
         )?;
         writeln!(
             f,
-            "{:<7} {:>5} {:>6} {:>6} {:>6} {:>7} {:>7} {:>7} {:>7} {:>6} {:>6} {:>5} {:>5} {:>7}",
+            "{:<7} {:>5} {:>6} {:>6} {:>6} {:>6} {:>6} {:>7} {:>7} {:>7} {:>7} {:>6} {:>6} {:>5} {:>5} {:>7}",
             "",
             "seeds",
             "life50",
             "life10",
             ">=95%",
+            "held50",
+            "held10",
             "tip px",
             "joint°",
             "palm°",
@@ -494,12 +507,14 @@ impl fmt::Display for Sweep {
             let d = Distribution::of(&group);
             writeln!(
                 f,
-                "{:<7} {:>5} {:>5.0}% {:>5.0}% {:>5.0}% {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>6.2} {:>6.2} {:>5} {:>5} {:>7.2}",
+                "{:<7} {:>5} {:>5.0}% {:>5.0}% {:>5.0}% {:>5.0}% {:>5.0}% {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>6.2} {:>6.2} {:>5} {:>5} {:>7.2}",
                 label,
                 d.seeds,
                 100.0 * d.life_median,
                 100.0 * d.life_p10,
                 100.0 * d.life_at_least_95,
+                100.0 * d.held_median,
+                100.0 * d.held_p10,
                 d.tip_px_median,
                 d.joint_deg_median,
                 d.palm_deg_median,

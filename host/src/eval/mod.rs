@@ -70,6 +70,10 @@ pub struct EvalReport {
     /// which the mean fingertip error stays above `lost_error_px` for [`LOST_RUN`] frames;
     /// 1 if that never happens.
     pub track_life: f64,
+    /// Fraction (0–1) of all frames whose mean fingertip error is at most `lost_error_px`,
+    /// wherever they fall: unlike the track life, a hand that strays over the threshold and
+    /// comes back is counted for the frames it is held again.
+    pub held_share: f64,
     /// Mean fingertip error of every frame, over all tips and cameras (px).
     pub fingertip_mean_by_frame: Vec<f64>,
     /// Frames the tracker flagged `lost`, when the states file has that column.
@@ -123,6 +127,7 @@ pub fn evaluate_at(seq: &Path, states_csv: &Path, lost_error_px: f64) -> Result<
     })?;
     report.lost_error_px = lost_error_px;
     report.track_life = track_life_at(&report.fingertip_mean_by_frame, lost_error_px);
+    report.held_share = held_share_at(&report.fingertip_mean_by_frame, lost_error_px);
     report.lost_frames = estimated
         .extra("lost")
         .map(|lost| lost.iter().filter(|&&v| v != 0.0).count());
@@ -218,6 +223,7 @@ pub fn compare(
         palm_translation_max_mm: translation.iter().copied().fold(0.0, f64::max),
         lost_error_px: LOST_ERROR_PX,
         track_life: track_life(&by_frame),
+        held_share: held_share_at(&by_frame, LOST_ERROR_PX),
         frames_to_acquire: acquisitions(&by_frame, &vec![true; truth.len()]).0,
         reacquired_at: acquisitions(&by_frame, &vec![true; truth.len()]).1,
         fingertip_mean_by_frame: by_frame,
@@ -300,6 +306,16 @@ pub fn track_life_at(errors: &[f64], lost_error_px: f64) -> f64 {
     1.0
 }
 
+/// Fraction of frames whose error (px) is at most `lost_error_px` (a NaN error is not held);
+/// 1 with no frame.
+pub fn held_share_at(errors: &[f64], lost_error_px: f64) -> f64 {
+    if errors.is_empty() {
+        return 1.0;
+    }
+    let held = errors.iter().filter(|&&e| e <= lost_error_px).count();
+    held as f64 / errors.len() as f64
+}
+
 /// Image distance (px) between frame `i`'s origin at the true and at the estimated state.
 /// A point that does not project (at or behind the camera) counts as the image diagonal.
 pub fn reprojection_error(cam: &Camera, truth: &Poses, estimate: &Poses, i: usize) -> f64 {
@@ -341,5 +357,16 @@ mod tests {
         let errors = e(&[1., 1., 1., 1., 1., 50., 50., 1., 1., 1., 1., 1.]);
         assert_eq!(acquisitions(&errors, &[true; 12]), (Some(0), vec![]));
         assert_eq!(acquisitions(&[50.; 8], &[true; 8]), (None, vec![]));
+    }
+
+    #[test]
+    fn the_held_share_counts_frames_held_again_after_the_life_ends() {
+        // Lost for 5 frames from frame 2, then held again to the end.
+        let errors = [1., 1., 50., 50., 50., 50., 50., 1., 1., 1.];
+        assert_eq!(track_life(&errors), 0.2);
+        assert_eq!(held_share_at(&errors, LOST_ERROR_PX), 0.5);
+        // At the threshold is held; over it, or not a number, is not.
+        assert_eq!(held_share_at(&[10.0, 10.01, f64::NAN, 0.0], 10.0), 0.5);
+        assert_eq!(held_share_at(&[], 10.0), 1.0);
     }
 }

@@ -46,6 +46,12 @@ impl fmt::Display for EvalReport {
             self.frames,
             self.lost_error_px
         )?;
+        writeln!(
+            f,
+            "frames held              {:8.1} %    (every frame with the fingertip error <= {} px, also after the track life ends)",
+            100.0 * self.held_share,
+            self.lost_error_px
+        )?;
         if let Some(lost) = self.lost_frames {
             writeln!(f, "frames flagged lost      {lost:8}")?;
         }
