@@ -19,6 +19,29 @@ fn eval_rows(seq: &Path, rows: &[Vec<f64>]) -> digiteyes_host::EvalReport {
     evaluate(seq, &path).unwrap()
 }
 
+/// The mouse sequence's report of `frames` frames with the palm 150 mm off on the frames
+/// `off` holds.
+fn palm_moved_on(
+    dir: &Path,
+    frames: usize,
+    off: impl Fn(usize) -> bool,
+) -> digiteyes_host::EvalReport {
+    let seq = small_sequence(dir, "mouse", frames);
+    let truth = Sequence::open(&seq).unwrap().read_truth().unwrap().rows;
+    let rows: Vec<Vec<f64>> = truth
+        .iter()
+        .enumerate()
+        .map(|(k, q)| {
+            let mut q = q.clone();
+            if off(k) {
+                q[4] += 150.0;
+            }
+            q
+        })
+        .collect();
+    eval_rows(&seq, &rows)
+}
+
 #[test]
 fn truth_against_itself_is_perfect() {
     let dir = tempfile::tempdir().unwrap();
@@ -169,20 +192,7 @@ fn track_life_ends_where_the_error_stays_high() {
 #[test]
 fn a_lost_track_shows_in_the_report() {
     let dir = tempfile::tempdir().unwrap();
-    let seq = small_sequence(dir.path(), "mouse", 8);
-    let truth = Sequence::open(&seq).unwrap().read_truth().unwrap().rows;
-    let rows: Vec<Vec<f64>> = truth
-        .iter()
-        .enumerate()
-        .map(|(k, q)| {
-            let mut q = q.clone();
-            if k >= 3 {
-                q[4] += 150.0;
-            }
-            q
-        })
-        .collect();
-    let r = eval_rows(&seq, &rows);
+    let r = palm_moved_on(dir.path(), 8, |k| k >= 3);
     assert_eq!(r.track_life, 3.0 / 8.0);
     assert!(r.fingertip_mean_by_frame[3] > 10.0 && r.fingertip_mean_by_frame[2] == 0.0);
 }
@@ -190,21 +200,8 @@ fn a_lost_track_shows_in_the_report() {
 #[test]
 fn a_hand_found_again_ends_the_life_but_counts_as_held_again() {
     let dir = tempfile::tempdir().unwrap();
-    let seq = small_sequence(dir.path(), "mouse", 10);
-    let truth = Sequence::open(&seq).unwrap().read_truth().unwrap().rows;
     // The palm 150 mm off over frames 2..7, right before and after.
-    let rows: Vec<Vec<f64>> = truth
-        .iter()
-        .enumerate()
-        .map(|(k, q)| {
-            let mut q = q.clone();
-            if (2..7).contains(&k) {
-                q[4] += 150.0;
-            }
-            q
-        })
-        .collect();
-    let r = eval_rows(&seq, &rows);
+    let r = palm_moved_on(dir.path(), 10, |k| (2..7).contains(&k));
     assert_eq!(r.track_life, 2.0 / 10.0);
     assert_eq!(r.held_share, 5.0 / 10.0);
     let json: serde_json::Value = serde_json::to_value(&r).unwrap();
