@@ -15,9 +15,10 @@
 //! and the lost flag's precision and recall (`lostP`, `lostR`), as the benchmark counts them,
 //! and the median share of frames held (`held50`, as `eval`'s frames held).
 //! Every variant after the first is also compared with the first seed by seed (paired):
-//! the mean change of track life, how many seeds gained or lost more than 5 points, and the
-//! two-sided sign test's p over those, and the mean change of the share of frames held (the median of 30 seeds moves by 10–20 points between
-//! sweeps by chance alone; pairing the same seeds sees far smaller effects).
+//! the mean change of track life, how many seeds gained or lost more than 5 points, the
+//! two-sided sign test's p over those, and the mean change of the share of frames held (the
+//! median of 30 seeds moves by 10–20 points between sweeps by chance alone; pairing the same
+//! seeds sees far smaller effects).
 //! For trying a change quickly; the benchmark itself is the judge.
 //!
 //! ```text

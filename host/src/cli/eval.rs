@@ -14,9 +14,9 @@ use crate::eval::evaluate_at;
 /// errors, and track life: the fraction of frames before the mean fingertip error stays
 /// above 10 px (`--lost-px`) for 5 frames, and the frames held: the share of all frames
 /// whose mean fingertip error is within that threshold, also after the life ends. With a
-/// `status` column (`track`'s output): the
-/// frames to acquire (the first frame from which the hand is claimed with the error under
-/// that threshold for 5 frames) and the re-acquisitions.
+/// `status` column (`track`'s output): the frames to acquire (the first frame from which the
+/// hand is claimed with the error under that threshold for 5 frames) and the
+/// re-acquisitions.
 #[derive(Args, Debug)]
 pub struct EvalArgs {
     /// Sequence folder (with truth.csv).
