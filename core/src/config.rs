@@ -23,7 +23,10 @@ pub const MAX_ROW_NONZEROS: usize = 7 + MAX_CHAIN;
 pub const MAX_HYPOTHESES: usize = 8;
 /// Most new hypotheses sampled on one frame.
 pub const MAX_SPAWN: usize = 4;
+/// Most fingers jumped to their other reading on one frame (`hypotheses::jump`).
+pub const MAX_JUMPS: usize = 2;
 /// Most hypotheses weighed on one frame: those carried, those sampled along weak directions,
-/// and the best with one finger (or all) kept where it was (`hypotheses::fingers`).
+/// the fingers jumped, and the best with one finger (or all) kept where it was
+/// (`hypotheses::fingers`).
 pub const MAX_CANDIDATES: usize =
-    MAX_HYPOTHESES + MAX_SPAWN + crate::hypotheses::fingers::MAX_FINGERS + 1;
+    MAX_HYPOTHESES + MAX_SPAWN + MAX_JUMPS + crate::hypotheses::fingers::MAX_FINGERS + 1;

@@ -1,6 +1,6 @@
 //! How many hypotheses, how they are sampled, merged and chosen.
 
-use crate::config::{MAX_HYPOTHESES, MAX_SPAWN};
+use crate::config::{MAX_HYPOTHESES, MAX_JUMPS, MAX_SPAWN};
 use crate::likelihood::LikelihoodConfig;
 use crate::state::StateKind;
 
@@ -46,6 +46,14 @@ pub struct HypothesesConfig {
     /// New hypotheses sampled per frame, 0..=[`MAX_SPAWN`]: pairs on either side of the best
     /// along its weakest directions.
     pub spawn_per_frame: u8,
+    /// Fingers jumped to their other reading per scored frame, 0..=[`MAX_JUMPS`]: the
+    /// fingers of the best whose jump ([`jump`](super::jump)) moves them least in the image.
+    pub jumps_per_frame: u8,
+    /// A jump turns its pivot joint by at least this much (rad).
+    pub jump_min_turn_rad: f32,
+    /// A jump is weighed only when it moves the finger's link ends at most this far in the
+    /// image, on the mean over the cameras (px): the readings the cameras see alike.
+    pub jump_max_moved_px: f32,
     /// Also weigh, every frame, the best with each finger's update undone (the finger where
     /// it was on the last frame), and with every finger's undone: a finger the slices pulled
     /// onto a neighbour's edges scores worse than where it was.
@@ -90,6 +98,15 @@ impl HypothesesConfig {
             usize::from(self.spawn_per_frame).min(MAX_SPAWN)
         }
     }
+
+    /// `jumps_per_frame` clamped to [`MAX_JUMPS`], and to 0 for a single hypothesis.
+    pub fn jumps(&self) -> usize {
+        if self.count() == 1 {
+            0
+        } else {
+            usize::from(self.jumps_per_frame).min(MAX_JUMPS)
+        }
+    }
 }
 
 impl Default for HypothesesConfig {
@@ -97,6 +114,9 @@ impl Default for HypothesesConfig {
         HypothesesConfig {
             count: 1,
             spawn_per_frame: 2,
+            jumps_per_frame: 0,
+            jump_min_turn_rad: 0.3,
+            jump_max_moved_px: 4.0,
             keep_fingers: true,
             spread: Spread::default(),
             spawn_step: 1.0,

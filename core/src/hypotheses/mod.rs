@@ -20,6 +20,7 @@
 
 pub mod config;
 pub mod fingers;
+pub mod jump;
 pub mod merge;
 mod rank;
 pub mod score;
@@ -252,6 +253,7 @@ impl MultiTracker {
         let mut candidates: Vec<Hypothesis, MAX_CANDIDATES> = Vec::new();
         let n = self.tracker.model().n_states();
         let mut samples = Vec::<TrackMemory, { crate::config::MAX_SPAWN }>::new();
+        let mut jumped = Vec::<TrackMemory, { crate::config::MAX_JUMPS }>::new();
         let mut undone = Vec::<Hypothesis, { fingers::MAX_FINGERS + 1 }>::new();
         // 1. Every hypothesis through the loop; the weak directions of the best.
         for (index, h) in self.hypotheses.iter().enumerate() {
@@ -290,6 +292,21 @@ impl MultiTracker {
                         sample.velocity = None;
                         let _ = samples.push(sample);
                     }
+                }
+                let jumps = jump::finger_jumps(
+                    self.tracker.model(),
+                    self.tracker.cameras(),
+                    &self.fingers,
+                    &memory.state,
+                    self.config.jump_min_turn_rad,
+                    self.config.jump_max_moved_px,
+                    self.config.jumps(),
+                );
+                for j in &jumps {
+                    let mut sample = memory.clone();
+                    sample.state.copy_from_slice(&j.state[..n]);
+                    sample.velocity = None;
+                    let _ = jumped.push(sample);
                 }
             }
             let kept_fingers = if index == 0 && self.config.keep_fingers {
@@ -335,7 +352,7 @@ impl MultiTracker {
         // 2. The samples refined on this frame, carrying on with the best's motion.
         let parent_velocity = candidates.first().and_then(|c| c.memory.velocity);
         let mut sampled = 0u8;
-        for sample in &samples {
+        for sample in samples.iter().chain(&jumped) {
             if self.tracker.restore(sample).is_err() {
                 continue;
             }
