@@ -97,7 +97,7 @@ pub fn finger_jumps(
 ) -> Vec<Jump, MAX_JUMPS> {
     let mut out: Vec<Jump, MAX_FINGERS> = Vec::new();
     let n = model.n_states().min(MAX_STATES);
-    if q.len() != n || cameras.is_empty() {
+    if count == 0 || q.len() != n || cameras.is_empty() {
         return Vec::new();
     }
     let Ok(poses) = Poses::compute(model, q) else {
