@@ -23,10 +23,10 @@ pub const MAX_ROW_NONZEROS: usize = 7 + MAX_CHAIN;
 pub const MAX_HYPOTHESES: usize = 8;
 /// Most new hypotheses sampled on one frame.
 pub const MAX_SPAWN: usize = 4;
-/// Most fingers jumped to their other reading on one frame (`hypotheses::jump`).
+/// Most fingers jumped to their other reading on one frame (`hypotheses::jump`); the jumps
+/// take the places of samples, so samples and jumps together are at most [`MAX_SPAWN`].
 pub const MAX_JUMPS: usize = 2;
-/// Most hypotheses weighed on one frame: those carried, those sampled along weak directions,
-/// the fingers jumped, and the best with one finger (or all) kept where it was
-/// (`hypotheses::fingers`).
+/// Most hypotheses weighed on one frame: those carried, those sampled along weak directions
+/// or jumped, and the best with one finger (or all) kept where it was (`hypotheses::fingers`).
 pub const MAX_CANDIDATES: usize =
-    MAX_HYPOTHESES + MAX_SPAWN + MAX_JUMPS + crate::hypotheses::fingers::MAX_FINGERS + 1;
+    MAX_HYPOTHESES + MAX_SPAWN + crate::hypotheses::fingers::MAX_FINGERS + 1;

@@ -48,8 +48,10 @@ pub struct HypothesesConfig {
     pub spawn_per_frame: u8,
     /// Fingers jumped to their other reading per scored frame, 0..=[`MAX_JUMPS`]: the
     /// fingers of the best whose jump ([`jump`](super::jump)) moves them least in the image.
-    /// Default 0 (none computed): on three fresh sets of 60 seeds, two jumps at K = 4 left
-    /// the track life within noise and raised the mono joint error on each
+    /// They take the places of samples: past [`MAX_SPAWN`] samples and jumps together, the
+    /// last jumps are left out.
+    /// Default 0 (none computed): on three fresh sets of 60 seeds, two jumps at K = 4
+    /// shortened the track life and raised the joint error in every group
     /// (`docs/hypotheses.md`, "Kinematic jumps").
     pub jumps_per_frame: u8,
     /// A jump turns its pivot joint by at least this much (rad).

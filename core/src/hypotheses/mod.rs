@@ -253,7 +253,6 @@ impl MultiTracker {
         let mut candidates: Vec<Hypothesis, MAX_CANDIDATES> = Vec::new();
         let n = self.tracker.model().n_states();
         let mut samples = Vec::<TrackMemory, { crate::config::MAX_SPAWN }>::new();
-        let mut jumped = Vec::<TrackMemory, { crate::config::MAX_JUMPS }>::new();
         let mut undone = Vec::<Hypothesis, { fingers::MAX_FINGERS + 1 }>::new();
         // 1. Every hypothesis through the loop; the weak directions of the best.
         for (index, h) in self.hypotheses.iter().enumerate() {
@@ -306,7 +305,8 @@ impl MultiTracker {
                     let mut sample = memory.clone();
                     sample.state.copy_from_slice(&j.state[..n]);
                     sample.velocity = None;
-                    let _ = jumped.push(sample);
+                    // Past MAX_SPAWN samples and jumps together, the jump is left out.
+                    let _ = samples.push(sample);
                 }
             }
             let kept_fingers = if index == 0 && self.config.keep_fingers {
@@ -352,7 +352,7 @@ impl MultiTracker {
         // 2. The samples refined on this frame, carrying on with the best's motion.
         let parent_velocity = candidates.first().and_then(|c| c.memory.velocity);
         let mut sampled = 0u8;
-        for sample in samples.iter().chain(&jumped) {
+        for sample in &samples {
             if self.tracker.restore(sample).is_err() {
                 continue;
             }
