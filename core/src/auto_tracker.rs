@@ -777,11 +777,14 @@ impl AutoTracker {
             .max(self.hypotheses.count)
             .min(MAX_HYPOTHESES as u8);
         // The leaves themselves are compared: nothing sampled around them (a confirming frame
-        // costs one tracker pass and one score per leaf).
+        // costs one tracker pass and one score per leaf), by their image alone (a leaf has no
+        // motion yet for the temporal term to weigh).
         self.multi.set_config(HypothesesConfig {
             count,
             spawn_per_frame: 0,
+            jumps_per_frame: 0,
             keep_fingers: false,
+            motion_weight: 0.0,
             score_every_frames: 1,
             switch_margin: finder.confirm_switch_margin,
             score_memory: finder.confirm_score_memory,

@@ -33,6 +33,7 @@ pub use config::{HypothesesConfig, Spread};
 use crate::auto_tracker::AutoError;
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_CANDIDATES, MAX_HYPOTHESES};
+use crate::estimator::FreeMask;
 use crate::frame::FrameView;
 use crate::likelihood::{BuiltEdges, EdgeMap, Scene};
 use crate::state::{clamp_to_limit, renormalise_quaternion};
@@ -251,6 +252,8 @@ impl MultiTracker {
             let _ = self.built.push(built);
         }
         let mut candidates: Vec<Hypothesis, MAX_CANDIDATES> = Vec::new();
+        // `parents[c]`: the carried hypothesis candidate `c` descends from.
+        let mut parents: Vec<usize, MAX_CANDIDATES> = Vec::new();
         let n = self.tracker.model().n_states();
         let mut samples = Vec::<TrackMemory, { crate::config::MAX_SPAWN }>::new();
         let mut undone = Vec::<Hypothesis, { fingers::MAX_FINGERS + 1 }>::new();
@@ -345,9 +348,11 @@ impl MultiTracker {
                 ranked_score: h.ranked_score,
                 age: h.age + 1,
             });
+            let _ = parents.push(index);
         }
         for u in undone {
             let _ = candidates.push(u);
+            let _ = parents.push(0);
         }
         // 2. The samples refined on this frame, carrying on with the best's motion.
         let parent_velocity = candidates.first().and_then(|c| c.memory.velocity);
@@ -367,13 +372,21 @@ impl MultiTracker {
                 ranked_score: None,
                 age: 0,
             });
+            let _ = parents.push(0);
         }
         // 3. Scores.
-        for c in candidates.iter_mut() {
+        let free = self.tracker.free();
+        for (c, &parent) in candidates.iter_mut().zip(&parents) {
             let scene = Scene::new(self.tracker.model(), self.tracker.cameras(), frames, &maps);
             let mut score = self.scorer.score(&scene, &c.memory.state, &likelihood);
             if c.report.lost {
                 score -= self.config.lost_penalty;
+            }
+            if self.config.motion_weight > 0.0 {
+                if let Some(p) = self.hypotheses.get(parent) {
+                    score -= self.config.motion_weight
+                        * departure(&c.memory.state, &p.memory, free, &self.config.spread);
+                }
             }
             c.score = score;
             c.ranked_score = Some(rank::ranked_score(
@@ -459,5 +472,59 @@ impl MultiTracker {
             count: self.hypotheses.len() as u8,
             ..MultiReport::default()
         })
+    }
+}
+
+/// How far `state` departs from what `parent` predicts (its state moved on by its velocity):
+/// the sum over the free states of the squared difference in [`Spread`] units.
+fn departure(state: &[f32], parent: &TrackMemory, free: FreeMask, spread: &Spread) -> f32 {
+    let mut sum = 0.0f32;
+    for (i, (now, was)) in state.iter().zip(&parent.state).enumerate() {
+        if !free.contains(i) {
+            continue;
+        }
+        let moved = parent.velocity.as_ref().map_or(0.0, |v| v[i]);
+        let d = (now - (was + moved)) / spread.for_state(i);
+        sum += d * d;
+    }
+    sum
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn memory(state: &[f32], velocity: Option<[f32; crate::config::MAX_STATES]>) -> TrackMemory {
+        TrackMemory {
+            state: state.iter().copied().collect(),
+            velocity,
+            silhouette_reference: None,
+        }
+    }
+
+    #[test]
+    fn departure_is_zero_on_the_prediction_and_counts_spread_units() {
+        let spread = Spread::default();
+        let free = FreeMask::all(9);
+        let parent_state = [1.0, 0.0, 0.0, 0.0, 10.0, 20.0, 30.0, 0.5, 0.2];
+        let mut velocity = [0.0f32; crate::config::MAX_STATES];
+        velocity[7] = 0.1;
+        velocity[4] = 2.0;
+        let parent = memory(&parent_state, Some(velocity));
+        let mut predicted = parent_state;
+        predicted[7] = 0.6;
+        predicted[4] = 12.0;
+        assert_eq!(departure(&predicted, &parent, free, &spread), 0.0);
+        // One joint a unit (0.35 rad) and the translation half a unit (5 mm) off: 1 + 0.25.
+        let mut moved = predicted;
+        moved[8] += 0.35;
+        moved[5] -= 5.0;
+        let d = departure(&moved, &parent, free, &spread);
+        assert!((d - 1.25).abs() < 1e-4, "{d}");
+        // States that are not free do not count; no velocity predicts no motion.
+        let joints_fixed = FreeMask::from_states(&[0, 1, 2, 3, 4, 5, 6, 7]).unwrap();
+        assert!((departure(&moved, &parent, joints_fixed, &spread) - 0.25).abs() < 1e-4);
+        let still = memory(&parent_state, None);
+        assert_eq!(departure(&parent_state, &still, free, &spread), 0.0);
     }
 }

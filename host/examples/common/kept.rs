@@ -102,6 +102,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "jumps" => o.hypotheses.jumps_per_frame = f as u8,
             "jturn" => o.hypotheses.jump_min_turn_rad = f,
             "jpx" => o.hypotheses.jump_max_moved_px = f,
+            "mw" => o.hypotheses.motion_weight = f,
             "k" => o.hypotheses.count = f as u8,
             "smem" => o.hypotheses.score_memory = f,
             "switch" => o.hypotheses.switch_margin = f,
