@@ -51,8 +51,9 @@ pub struct HypothesesConfig {
     /// They take the places of samples: past [`MAX_SPAWN`] samples and jumps together, the
     /// last jumps are left out.
     /// Default 0 (none computed): on three fresh sets of 60 seeds, two jumps at K = 4
-    /// shortened the track life and raised the joint error in every group
-    /// (`docs/hypotheses.md`, "Kinematic jumps").
+    /// shortened the track life and raised the joint error in every group; under
+    /// [`HypothesesConfig::motion_weight`] they are neutral (`docs/hypotheses.md`, "Kinematic
+    /// jumps").
     pub jumps_per_frame: u8,
     /// A jump turns its pivot joint by at least this much (rad).
     pub jump_min_turn_rad: f32,
