@@ -476,16 +476,21 @@ impl MultiTracker {
 }
 
 /// How far `state` departs from what `parent` predicts (its state moved on by its velocity):
-/// the sum over the free states of the squared difference in [`Spread`] units.
+/// the sum over the free states of the squared difference in [`Spread`] units. States whose
+/// unit is not a positive number, and differences that are not finite, count nothing.
 fn departure(state: &[f32], parent: &TrackMemory, free: FreeMask, spread: &Spread) -> f32 {
     let mut sum = 0.0f32;
     for (i, (now, was)) in state.iter().zip(&parent.state).enumerate() {
-        if !free.contains(i) {
+        let unit = spread.for_state(i);
+        let positive = unit.is_finite() && unit > 0.0;
+        if !free.contains(i) || !positive {
             continue;
         }
         let moved = parent.velocity.as_ref().map_or(0.0, |v| v[i]);
-        let d = (now - (was + moved)) / spread.for_state(i);
-        sum += d * d;
+        let d = (now - (was + moved)) / unit;
+        if d.is_finite() {
+            sum += d * d;
+        }
     }
     sum
 }
@@ -526,5 +531,15 @@ mod tests {
         assert!((departure(&moved, &parent, joints_fixed, &spread) - 0.25).abs() < 1e-4);
         let still = memory(&parent_state, None);
         assert_eq!(departure(&parent_state, &still, free, &spread), 0.0);
+        // A unit of zero or NaN, or a state that is not finite, never makes the score NaN.
+        let broken = Spread {
+            joint_rad: 0.0,
+            translation_mm: f32::NAN,
+            ..spread
+        };
+        assert_eq!(departure(&moved, &parent, free, &broken), 0.0);
+        let mut bad = moved;
+        bad[8] = f32::INFINITY;
+        assert!((departure(&bad, &parent, free, &spread) - 0.25).abs() < 1e-4);
     }
 }
