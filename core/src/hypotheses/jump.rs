@@ -164,9 +164,6 @@ fn jump_at(
     let mut state = [0.0f32; MAX_STATES];
     state[..q.len()].copy_from_slice(q);
     let before = world.clone();
-    let mut moved_sum = 0.0f32;
-    let mut moved_count = 0u32;
-    let mut joints_fitted = 0usize;
     for i in pivot_index..chain.frames.len() {
         let Some(joint) = chain.joints[i] else {
             continue;
@@ -176,6 +173,11 @@ fn jump_at(
         let Some(target_index) =
             (i + 1..chain.frames.len()).find(|&k| (before[k].t - origin).norm() > SAME_POINT_MM)
         else {
+            // A pivot that moves no point cannot jump; a later joint that moves none keeps
+            // its angle.
+            if i == pivot_index {
+                return None;
+            }
             continue;
         };
         let target = before[target_index].t;
@@ -203,11 +205,9 @@ fn jump_at(
             let parent = model.links().get(usize::from(chain.frames[k - 1]))?;
             world[k] = world[k - 1].compose(&row_transform(parent, &state));
         }
-        joints_fitted += 1;
     }
-    if joints_fitted == 0 || chain.joints.get(pivot_index).copied().flatten() != Some(pivot) {
-        return None;
-    }
+    let mut moved_sum = 0.0f32;
+    let mut moved_count = 0u32;
     let mut moved_mm = 0.0f32;
     for (after, was) in world.iter().zip(&before).skip(pivot_index + 1) {
         moved_mm += (after.t - was.t).norm();
@@ -259,22 +259,21 @@ fn image_distance(cameras: &[Camera], a: &Vector3<f32>, b: &Vector3<f32>) -> Opt
     (count > 0).then(|| sum / count as f32)
 }
 
-/// The joint states of the chain used, for tests.
-#[cfg(test)]
-fn chain_joints(
-    model: &Model,
-    fingers: &Fingers,
-    finger: usize,
-) -> Vec<u8, { crate::config::MAX_CHAIN }> {
-    Chain::of(model, fingers, finger)
-        .map(|c| c.joints.iter().flatten().copied().collect())
-        .unwrap_or_default()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::model::BASE_STATES;
+
+    /// The joint states of the chain used.
+    fn chain_joints(
+        model: &Model,
+        fingers: &Fingers,
+        finger: usize,
+    ) -> Vec<u8, { crate::config::MAX_CHAIN }> {
+        Chain::of(model, fingers, finger)
+            .map(|c| c.joints.iter().flatten().copied().collect())
+            .unwrap_or_default()
+    }
 
     /// The middle finger's MCP flexion (state) and the frames at the ends of its first link.
     const MCP: usize = 12;
