@@ -4,8 +4,8 @@
 //! weights, `sj`, `st`, `sq` the conditioning; `iters`, `predict`, `window`, `slices`, `palm`,
 //! `palmw`, `tipw`, `fvf`, `outer`, `knuckle` (0: no knuckle tips), `bounds` (0: the plain
 //! step); `angle` the edge-direction limit in degrees (90: off); `huber`, `tukey` the robust
-//! kernel's px; `k`, `s`, `spawn`, `smem`, `switch` the hypotheses (their count, scoring
-//! period, samples, score memory, switch margin); `csmem`, `cswitch` the confirm phase's score
+//! kernel's px; `k`, `s`, `spawn`, `step`, `smem`, `switch` the hypotheses (their count, scoring
+//! period, samples, their step in spread units, score memory, switch margin); `csmem`, `cswitch` the confirm phase's score
 //! memory and switch margin; `settle` the frames without the palm's position prior after an
 //! acquisition; `cdepth1` one camera's confirm-phase depth share; `cframes` its frames; `watch`
 //! its period, `drop` its bar; `depth1` one camera's local depth share; `turn` the local

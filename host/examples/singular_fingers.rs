@@ -11,7 +11,10 @@
 //! frames where the first variant *and* this one hold the hand (mean fingertip error within
 //! `eval`'s 10 px), so that a lost track's gross error does not stand in for the ambiguity;
 //! and, with several hypotheses, the RMS of each finger's best reading among the hypotheses
-//! carried (an oracle: was the right reading carried, for the score to choose?).
+//! carried (an oracle: was the right reading carried, for the score to choose?), and how well
+//! the score ranks the hypotheses of a frame: how often the output is the one nearest the
+//! truth (mean fingertip error), and of the pairs whose fingertip errors differ by over 3 px,
+//! how often the higher score goes with the nearer.
 //!
 //! ```text
 //! digiteyes bench robustness --seeds 60 --first-seed 8321 --keep /tmp/k8321
@@ -25,7 +28,7 @@ use anyhow::{Context, Result};
 use clap::Parser;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::{Model, BASE_STATES};
-use digiteyes_host::eval::{evaluate, LOST_ERROR_PX};
+use digiteyes_host::eval::{evaluate, reprojection_error, LOST_ERROR_PX};
 use digiteyes_host::sequence::hypotheses::read_hypotheses;
 use digiteyes_host::sequence::{read_states, Sequence};
 use digiteyes_host::track::{track_sequence_to, TrackOutputs};
@@ -76,7 +79,40 @@ struct FingerFrame {
 struct SeedRun {
     seed: u64,
     frames: Vec<(bool, Vec<FingerFrame>)>,
+    ranking: Ranking,
 }
+
+/// How well the hypotheses' scores rank them against the truth (mean fingertip error, px),
+/// over the frames that carry several.
+#[derive(Default, Clone, Copy)]
+struct Ranking {
+    /// Frames with several hypotheses.
+    frames: usize,
+    /// Of those, frames whose output (rank 0) is the hypothesis nearest the truth.
+    output_nearest: usize,
+    /// The output's fingertip error and the nearest hypothesis', summed over those frames.
+    output_px: f64,
+    nearest_px: f64,
+    /// Pairs of hypotheses of one frame whose fingertip errors differ by over
+    /// [`RANKED_PAIR_PX`], and of those, the pairs whose higher score is the nearer one.
+    pairs: usize,
+    pairs_agreeing: usize,
+}
+
+impl Ranking {
+    fn add(&mut self, other: &Ranking) {
+        self.frames += other.frames;
+        self.output_nearest += other.output_nearest;
+        self.output_px += other.output_px;
+        self.nearest_px += other.nearest_px;
+        self.pairs += other.pairs;
+        self.pairs_agreeing += other.pairs_agreeing;
+    }
+}
+
+/// Two hypotheses of a frame are a ranked pair when their fingertip errors differ by more
+/// than this (px).
+const RANKED_PAIR_PX: f64 = 3.0;
 
 /// Each finger's frame index and its joint states.
 fn fingers(model: &Model) -> Result<Vec<(usize, Vec<usize>)>> {
@@ -152,6 +188,11 @@ fn run(dir: &Path, variant: &str) -> Result<SeedRun> {
     let truth = kept::f32s(&sequence.read_truth()?.rows);
     let estimate = kept::f32s(&states.rows);
     let fingers = fingers(model)?;
+    let tips: Vec<usize> = FINGERS
+        .iter()
+        .filter_map(|name| model.find(&name.replace(".link1", ".tip")))
+        .collect();
+    let mut ranking = Ranking::default();
     let mut frames = Vec::new();
     for (k, (t, e)) in truth.iter().zip(&estimate).enumerate() {
         let poses = Poses::compute(model, t)?;
@@ -180,8 +221,54 @@ fn run(dir: &Path, variant: &str) -> Result<SeedRun> {
             })
             .collect();
         frames.push((held, per_finger));
+        if let Some(hypotheses) = carried.as_ref().and_then(|c| c.get(k)) {
+            let mut scored = Vec::new();
+            for h in hypotheses {
+                let state: Vec<f32> = h.state.iter().map(|&v| v as f32).collect();
+                let estimate = Poses::compute(model, &state)?;
+                let mut px = Vec::new();
+                for camera in &sequence.cameras {
+                    px.extend(
+                        tips.iter()
+                            .map(|&tip| reprojection_error(camera, &poses, &estimate, tip)),
+                    );
+                }
+                let mean = px.iter().sum::<f64>() / px.len().max(1) as f64;
+                scored.push((h.rank, h.score, mean));
+            }
+            ranking.add(&rank(&scored));
+        }
     }
-    Ok(SeedRun { seed, frames })
+    Ok(SeedRun {
+        seed,
+        frames,
+        ranking,
+    })
+}
+
+/// The [`Ranking`] of one frame's hypotheses, each as (rank, score, fingertip error px).
+fn rank(scored: &[(usize, f64, f64)]) -> Ranking {
+    let mut r = Ranking::default();
+    if scored.len() < 2 {
+        return r;
+    }
+    let nearest = scored.iter().map(|h| h.2).fold(f64::INFINITY, f64::min);
+    let Some(output) = scored.iter().find(|h| h.0 == 0) else {
+        return r;
+    };
+    r.frames = 1;
+    r.output_nearest = usize::from(output.2 <= nearest);
+    r.output_px = output.2;
+    r.nearest_px = nearest;
+    for (i, a) in scored.iter().enumerate() {
+        for b in &scored[i + 1..] {
+            if (a.2 - b.2).abs() > RANKED_PAIR_PX && a.1 != b.1 {
+                r.pairs += 1;
+                r.pairs_agreeing += usize::from((a.1 > b.1) == (a.2 < b.2));
+            }
+        }
+    }
+    r
 }
 
 /// Frames after a finger leaves a singular configuration that count as just left it.
@@ -320,6 +407,25 @@ fn main() -> Result<()> {
                     })
                     .collect();
                 println!("{variant} {group} {angle}° | {}", cells.join(" | "));
+            }
+            let mut r = Ranking::default();
+            for run in runs.iter().filter(|r| r.seed % 2 == parity) {
+                r.add(&run.ranking);
+            }
+            if r.frames > 0 {
+                let share = |a: usize, b: usize| 100.0 * a as f64 / b.max(1) as f64;
+                println!(
+                    "{variant} {group} ranking | {} frames with several hypotheses: the output \
+                     nearest the truth on {:.0} %, its fingertips {:.2} px against the nearest's \
+                     {:.2} px | {} pairs over {RANKED_PAIR_PX} px apart: the higher score the \
+                     nearer in {:.0} %",
+                    r.frames,
+                    share(r.output_nearest, r.frames),
+                    r.output_px / r.frames as f64,
+                    r.nearest_px / r.frames as f64,
+                    r.pairs,
+                    share(r.pairs_agreeing, r.pairs),
+                );
             }
         }
         if baseline.is_none() {

@@ -103,6 +103,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "jturn" => o.hypotheses.jump_min_turn_rad = f,
             "jpx" => o.hypotheses.jump_max_moved_px = f,
             "mw" => o.hypotheses.motion_weight = f,
+            "step" => o.hypotheses.spawn_step = f,
             "k" => o.hypotheses.count = f as u8,
             "smem" => o.hypotheses.score_memory = f,
             "switch" => o.hypotheses.switch_margin = f,
