@@ -29,9 +29,9 @@ use anyhow::Result;
 use clap::Parser;
 use digiteyes_host::bench::robustness::count_run;
 use digiteyes_host::eval::{evaluate, stats};
+use digiteyes_host::parallel;
 use digiteyes_host::track::track_sequence_opts;
 use std::path::PathBuf;
-use std::sync::Mutex;
 
 #[path = "common/kept.rs"]
 mod kept;
@@ -77,49 +77,35 @@ fn main() -> Result<()> {
     let mut first: Option<Vec<Run>> = None;
     for name in &args.variants {
         let (config, options) = variant(name)?;
-        let results = Mutex::new(Vec::new());
-        let next = Mutex::new(0usize);
-        std::thread::scope(|scope| {
-            for _ in 0..args.jobs {
-                scope.spawn(|| loop {
-                    let i = {
-                        let mut n = next.lock().unwrap();
-                        *n += 1;
-                        *n - 1
-                    };
-                    let Some((seed, dir)) = seeds.get(i) else {
-                        break;
-                    };
-                    let out = std::env::temp_dir()
-                        .join(format!("kept_ab_{}_{seed}.csv", std::process::id()));
-                    let r = track_sequence_opts(dir, &out, config, false, None, &options).and_then(
-                        |_| {
-                            let report = evaluate(dir, &out)?;
-                            let judged = count_run(dir, &out, &report)?;
-                            Ok((report, judged))
-                        },
-                    );
-                    let _ = std::fs::remove_file(&out);
-                    match r {
-                        Ok((r, judged)) => {
-                            let tip = r.cameras.iter().map(|c| c.fingertip_mean_px).sum::<f64>()
-                                / r.cameras.len() as f64;
-                            results.lock().unwrap().push((
-                                *seed,
-                                r.track_life,
-                                r.joint_rms_deg,
-                                tip,
-                                judged,
-                                r.held_share,
-                            ))
-                        }
-                        Err(e) => eprintln!("seed {seed}: {e:#}"),
-                    }
-                });
+        let runs = parallel::map(&seeds, args.jobs, |(seed, dir)| {
+            let out =
+                std::env::temp_dir().join(format!("kept_ab_{}_{seed}.csv", std::process::id()));
+            let r = track_sequence_opts(dir, &out, config, false, None, &options).and_then(|_| {
+                let report = evaluate(dir, &out)?;
+                let judged = count_run(dir, &out, &report)?;
+                Ok((report, judged))
+            });
+            let _ = std::fs::remove_file(&out);
+            match r {
+                Ok((r, judged)) => {
+                    let tip = r.cameras.iter().map(|c| c.fingertip_mean_px).sum::<f64>()
+                        / r.cameras.len() as f64;
+                    Some((
+                        *seed,
+                        r.track_life,
+                        r.joint_rms_deg,
+                        tip,
+                        judged,
+                        r.held_share,
+                    ))
+                }
+                Err(e) => {
+                    eprintln!("seed {seed}: {e:#}");
+                    None
+                }
             }
         });
-        let mut results = results.into_inner().unwrap();
-        results.sort_by_key(|r| r.0);
+        let results: Vec<_> = runs.into_iter().flatten().collect();
         let lives: Vec<Run> = results.iter().map(|r| (r.0, r.1, r.5)).collect();
         match &first {
             None => first = Some(lives),

@@ -22,13 +22,13 @@
 //! ```
 
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
 use anyhow::{Context, Result};
 use clap::Parser;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::{Model, BASE_STATES};
 use digiteyes_host::eval::{evaluate, reprojection_error, LOST_ERROR_PX};
+use digiteyes_host::parallel;
 use digiteyes_host::sequence::hypotheses::read_hypotheses;
 use digiteyes_host::sequence::{read_states, Sequence};
 use digiteyes_host::track::{track_sequence_to, TrackOutputs};
@@ -355,27 +355,14 @@ fn main() -> Result<()> {
          held by both variants (their count)"
     );
     for variant in &args.variants {
-        let results = Mutex::new(Vec::new());
-        let next = Mutex::new(0usize);
-        std::thread::scope(|scope| {
-            for _ in 0..args.jobs {
-                scope.spawn(|| loop {
-                    let i = {
-                        let mut n = next.lock().unwrap_or_else(|e| e.into_inner());
-                        *n += 1;
-                        *n - 1
-                    };
-                    let Some(dir) = dirs.get(i) else { break };
-                    let r = run(dir, variant);
-                    match r {
-                        Ok(r) => results.lock().unwrap_or_else(|e| e.into_inner()).push(r),
-                        Err(e) => eprintln!("{}: {e:#}", dir.display()),
-                    }
-                });
-            }
-        });
-        let mut runs = results.into_inner().unwrap_or_else(|e| e.into_inner());
-        runs.sort_by_key(|r| r.seed);
+        let runs: Vec<SeedRun> = parallel::map(&dirs, args.jobs, |dir| {
+            run(dir, variant)
+                .map_err(|e| eprintln!("{}: {e:#}", dir.display()))
+                .ok()
+        })
+        .into_iter()
+        .flatten()
+        .collect();
         let base = baseline.as_deref().unwrap_or(&runs);
         let held = |runs: &[SeedRun], seed: u64, k: usize| {
             runs.iter()

@@ -44,6 +44,7 @@ pub mod link;
 pub mod listen;
 pub mod mouse_pole;
 pub mod overlay;
+pub mod parallel;
 pub mod progress;
 pub mod render;
 pub mod report;

@@ -4,8 +4,6 @@
 
 use std::fmt;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
@@ -324,31 +322,21 @@ pub fn run(args: &RobustnessArgs) -> Result<Sweep> {
         }
     };
     let seeds: Vec<u64> = (args.first_seed..args.first_seed + args.seeds).collect();
-    let next = AtomicUsize::new(0);
-    let results = Mutex::new(Vec::new());
-    let failures = Mutex::new(Vec::new());
-    std::thread::scope(|scope| {
-        for _ in 0..args.jobs {
-            scope.spawn(|| loop {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                let Some(&seed) = seeds.get(i) else { break };
-                match run_seed(seed, args, &dir) {
-                    Ok(r) => results.lock().map(|mut v| v.push(r)).unwrap_or(()),
-                    Err(e) => failures
-                        .lock()
-                        .map(|mut v| v.push((seed, format!("{e:#}"))))
-                        .unwrap_or(()),
-                }
-                if args.keep.is_none() {
-                    let _ = std::fs::remove_dir_all(dir.join(format!("seed{seed:04}")));
-                }
-            });
+    let jobs = usize::try_from(args.jobs).unwrap_or(usize::MAX);
+    let runs = crate::parallel::map(&seeds, jobs, |&seed| {
+        let run = run_seed(seed, args, &dir).map_err(|e| (seed, format!("{e:#}")));
+        if args.keep.is_none() {
+            let _ = std::fs::remove_dir_all(dir.join(format!("seed{seed:04}")));
         }
+        run
     });
-    let mut seeds = results.into_inner().unwrap_or_default();
-    seeds.sort_by_key(|r| r.seed);
-    let mut failed = failures.into_inner().unwrap_or_default();
-    failed.sort();
+    let (mut seeds, mut failed) = (Vec::new(), Vec::new());
+    for run in runs {
+        match run {
+            Ok(r) => seeds.push(r),
+            Err(e) => failed.push(e),
+        }
+    }
     let sweep = Sweep {
         motion: args.motion,
         frames: args.frames,
