@@ -13,8 +13,8 @@
 //! and, with several hypotheses, the RMS of each finger's best reading among the hypotheses
 //! carried (an oracle: was the right reading carried, for the score to choose?), and how well
 //! the score ranks the hypotheses of a frame: how often the output is the one nearest the
-//! truth (mean fingertip error), and of the pairs whose fingertip errors differ by over 3 px,
-//! how often the higher score goes with the nearer.
+//! truth (mean fingertip error), and of the pairs whose fingertip errors differ by over 3 px
+//! (and by over 10 px), how often the higher score goes with the nearer.
 //!
 //! ```text
 //! digiteyes bench robustness --seeds 60 --first-seed 8321 --keep /tmp/k8321
@@ -93,10 +93,10 @@ struct Ranking {
     /// The output's fingertip error and the nearest hypothesis', summed over those frames.
     output_px: f64,
     nearest_px: f64,
-    /// Pairs of hypotheses of one frame whose fingertip errors differ by over
+    /// Pairs of hypotheses of one frame whose fingertip errors differ by over each of
     /// [`RANKED_PAIR_PX`], and of those, the pairs whose higher score is the nearer one.
-    pairs: usize,
-    pairs_agreeing: usize,
+    pairs: [usize; RANKED_PAIR_PX.len()],
+    pairs_agreeing: [usize; RANKED_PAIR_PX.len()],
 }
 
 impl Ranking {
@@ -105,14 +105,16 @@ impl Ranking {
         self.output_nearest += other.output_nearest;
         self.output_px += other.output_px;
         self.nearest_px += other.nearest_px;
-        self.pairs += other.pairs;
-        self.pairs_agreeing += other.pairs_agreeing;
+        for i in 0..RANKED_PAIR_PX.len() {
+            self.pairs[i] += other.pairs[i];
+            self.pairs_agreeing[i] += other.pairs_agreeing[i];
+        }
     }
 }
 
 /// Two hypotheses of a frame are a ranked pair when their fingertip errors differ by more
 /// than this (px).
-const RANKED_PAIR_PX: f64 = 3.0;
+const RANKED_PAIR_PX: [f64; 2] = [3.0, 10.0];
 
 /// Each finger's frame index and its joint states.
 fn fingers(model: &Model) -> Result<Vec<(usize, Vec<usize>)>> {
@@ -262,9 +264,11 @@ fn rank(scored: &[(usize, f64, f64)]) -> Ranking {
     r.nearest_px = nearest;
     for (i, a) in scored.iter().enumerate() {
         for b in &scored[i + 1..] {
-            if (a.2 - b.2).abs() > RANKED_PAIR_PX && a.1 != b.1 {
-                r.pairs += 1;
-                r.pairs_agreeing += usize::from((a.1 > b.1) == (a.2 < b.2));
+            for (i, &apart_px) in RANKED_PAIR_PX.iter().enumerate() {
+                if (a.2 - b.2).abs() > apart_px && a.1 != b.1 {
+                    r.pairs[i] += 1;
+                    r.pairs_agreeing[i] += usize::from((a.1 > b.1) == (a.2 < b.2));
+                }
             }
         }
     }
@@ -401,17 +405,26 @@ fn main() -> Result<()> {
             }
             if r.frames > 0 {
                 let share = |a: usize, b: usize| 100.0 * a as f64 / b.max(1) as f64;
+                let pairs: Vec<String> = RANKED_PAIR_PX
+                    .iter()
+                    .enumerate()
+                    .map(|(i, px)| {
+                        format!(
+                            "{} pairs over {px} px apart: the higher score the nearer in {:.0} %",
+                            r.pairs[i],
+                            share(r.pairs_agreeing[i], r.pairs[i])
+                        )
+                    })
+                    .collect();
                 println!(
                     "{variant} {group} ranking | {} frames with several hypotheses: the output \
                      nearest the truth on {:.0} %, its fingertips {:.2} px against the nearest's \
-                     {:.2} px | {} pairs over {RANKED_PAIR_PX} px apart: the higher score the \
-                     nearer in {:.0} %",
+                     {:.2} px | {}",
                     r.frames,
                     share(r.output_nearest, r.frames),
                     r.output_px / r.frames as f64,
                     r.nearest_px / r.frames as f64,
-                    r.pairs,
-                    share(r.pairs_agreeing, r.pairs),
+                    pairs.join(" | "),
                 );
             }
         }
