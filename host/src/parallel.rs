@@ -24,8 +24,12 @@ pub fn map<T: Sync, R: Send>(items: &[T], jobs: usize, f: impl Fn(&T) -> R + Syn
             .collect();
         workers
             .into_iter()
-            // A worker that panicked has already reported it; its results are lost with it.
-            .flat_map(|w| w.join().unwrap_or_default())
+            // A worker's panic goes on in the caller, as if `f` had run there: no result is
+            // dropped unseen.
+            .flat_map(|w| {
+                w.join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            })
             .collect()
     });
     done.sort_by_key(|(i, _)| *i);
@@ -44,5 +48,17 @@ mod tests {
             assert_eq!(squares, items.iter().map(|x| x * x).collect::<Vec<_>>());
         }
         assert!(map(&[] as &[u8], 2, |&x| x).is_empty());
+    }
+
+    #[test]
+    fn a_panic_in_one_item_reaches_the_caller() {
+        let items: Vec<u32> = (0..10).collect();
+        let caught = std::panic::catch_unwind(|| {
+            map(&items, 2, |&x| {
+                assert_ne!(x, 7, "item seven");
+                x
+            })
+        });
+        assert!(caught.is_err());
     }
 }
