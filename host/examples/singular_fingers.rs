@@ -1,9 +1,9 @@
 //! Joint error on fingers in singular configurations (issue 11's third target). On the
 //! sequences `bench robustness --keep DIR` kept, each variant tracks every seed, and each
 //! frame's fingers are classed at the *truth*: a finger is **singular** when the plane it bends
-//! in passes within an angle (`--angles-deg`, each printed) of every camera's centre (the thesis' singular subspace,
-//! Sec. 2.5.4: the finger projects onto one image line, and its line features no longer say
-//! how its bend is split among its joints). The plane is the one the finger's two distal links
+//! in passes within an angle (`--angles-deg`, each printed) of every camera's centre (the
+//! thesis' singular subspace, Sec. 2.5.4: the finger projects onto one image line, and its
+//! line features no longer say how its bend is split among its joints). The plane is the one the finger's two distal links
 //! turn in: through the first distal link's frame, normal to its joint axis.
 //!
 //! Printed per variant and group (mono, stereo): the finger-frames of each class, their joint
@@ -18,7 +18,8 @@
 //!
 //! ```text
 //! digiteyes bench robustness --seeds 60 --first-seed 8321 --keep /tmp/k8321
-//! cargo run --release -p digiteyes-host --example singular_fingers -- /tmp/k8321 default k=4
+//! cargo run --release -p digiteyes-host --example singular_fingers -- --dirs /tmp/k8321 -- \
+//!     default k=4
 //! ```
 
 use std::path::{Path, PathBuf};
