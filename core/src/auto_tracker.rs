@@ -534,9 +534,10 @@ impl AutoTracker {
             return Ok(self.search_again(multi, 0, None));
         }
         if !report.lost && self.recovery == Recovery::Search && self.watch.due() {
+            // The probation's score is the search's: reused only when the watch scores alike.
             let worst = match watch_score {
-                Some(worst) => worst,
-                None => self.worst_camera_score(frames, edge_buffers, &built)?,
+                Some(worst) if !self.watch.weighs_reverse() => worst,
+                _ => self.watch_score(frames, edge_buffers, &built)?,
             };
             watch_score = Some(worst);
             if self.watch.judge(worst) {
@@ -618,11 +619,41 @@ impl AutoTracker {
         built: &[BuiltEdges],
     ) -> Result<f32, AutoError> {
         let likelihood = self.finder.acquirer().config().likelihood;
-        let maps = reopened_edge_maps(edge_buffers, frames, &likelihood, built)?;
+        self.worst_camera_score_under(frames, edge_buffers, built, &likelihood)
+    }
+
+    /// [`Self::worst_camera_score`] under the watch's likelihood: the search's, with the
+    /// watch's weight of the reverse term.
+    fn watch_score(
+        &mut self,
+        frames: &[FrameView<'_>],
+        edge_buffers: &mut [&mut [u8]],
+        built: &[BuiltEdges],
+    ) -> Result<f32, AutoError> {
+        let likelihood = LikelihoodConfig {
+            reverse_weight: self.watch.config().reverse_weight,
+            ..self.finder.acquirer().config().likelihood
+        };
+        self.worst_camera_score_under(frames, edge_buffers, built, &likelihood)
+    }
+
+    /// The tracked state's worst camera score under `likelihood` (whose edge maps are the
+    /// search's).
+    fn worst_camera_score_under(
+        &mut self,
+        frames: &[FrameView<'_>],
+        edge_buffers: &mut [&mut [u8]],
+        built: &[BuiltEdges],
+        likelihood: &LikelihoodConfig,
+    ) -> Result<f32, AutoError> {
+        let maps = reopened_edge_maps(edge_buffers, frames, likelihood, built)?;
         let tracker = self.multi.tracker();
         let q = padded(tracker.state());
         let scene = Scene::new(tracker.model(), tracker.cameras(), frames, &maps);
-        let (_, worst) = self.finder.acquirer_mut().score_cameras(&scene, &q);
+        let (_, worst) = self
+            .finder
+            .acquirer_mut()
+            .score_cameras_under(&scene, &q, likelihood);
         Ok(worst)
     }
 
@@ -788,6 +819,9 @@ impl AutoTracker {
             score_every_frames: 1,
             switch_margin: finder.confirm_switch_margin,
             score_memory: finder.confirm_score_memory,
+            // The search's leaves are judged by the search's likelihood, whatever the
+            // tracker's hypotheses weigh.
+            likelihood: self.finder.acquirer().config().likelihood,
             ..self.hypotheses
         });
         self.multi.seed(others)?;

@@ -37,6 +37,11 @@ pub struct WatchConfig {
     /// How far (likelihood units, 0..=1) the worst camera's score may fall under the
     /// track's reference.
     pub max_drop: f32,
+    /// The checks weigh the [reverse chamfer term](crate::likelihood) (the edges near the
+    /// hand that no model line explains) by this, whatever the search's own weight
+    /// ([`LikelihoodConfig::reverse_weight`](crate::likelihood::LikelihoodConfig)); 0, the
+    /// default, leaves it out. The search's likelihood is otherwise the watch's.
+    pub reverse_weight: f32,
 }
 
 impl Default for WatchConfig {
@@ -44,6 +49,7 @@ impl Default for WatchConfig {
         WatchConfig {
             every_frames: 8,
             max_drop: 0.10,
+            reverse_weight: 0.0,
         }
     }
 }
@@ -81,6 +87,11 @@ impl Watch {
     /// The parameters.
     pub fn config(&self) -> &WatchConfig {
         &self.config
+    }
+
+    /// Whether the checks weigh the reverse chamfer term (a positive weight; not NaN).
+    pub fn weighs_reverse(&self) -> bool {
+        self.config.reverse_weight > 0.0
     }
 
     /// A check falls due every this many tracking frames (0: never).
@@ -139,6 +150,7 @@ mod tests {
             WatchConfig {
                 every_frames: n,
                 max_drop: 0.1,
+                ..WatchConfig::default()
             },
             WATCH_REFERENCE_PIXELS,
         )

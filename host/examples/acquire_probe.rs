@@ -99,6 +99,9 @@ struct Args {
     passes: Option<u8>,
     #[arg(long)]
     min_score: Option<f32>,
+    /// The search's likelihood weighs the reverse chamfer term by this (and the watch's).
+    #[arg(long)]
+    reverse_weight: Option<f32>,
     /// The local re-acquisition also starts from the library's best finger pose (true/false).
     #[arg(long)]
     local_library: Option<bool>,
@@ -274,6 +277,10 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             Some([a, b]) => [*a, *b],
             _ => d.coarse_sampling,
         },
+        likelihood: LikelihoodConfig {
+            reverse_weight: args.reverse_weight.unwrap_or(d.likelihood.reverse_weight),
+            ..d.likelihood
+        },
         ..d
     };
     let f = FinderConfig::default();
@@ -409,25 +416,28 @@ struct Run {
     refined: u32,
 }
 
-/// Finer likelihoods than the search's, for the leaves CSV: (stride, cap, samples per line,
-/// silhouette grid).
-const FINE: [(u8, f32, u8, u8); 4] = [
-    (2, 12.0, 12, 16),
-    (4, 24.0, 6, 48),
-    (1, 8.0, 12, 48),
-    (2, 8.0, 12, 48),
+/// Other likelihoods than the search's, for the leaves CSV: (stride, cap, samples per line,
+/// silhouette grid, reverse term's weight). The last is the search's with the reverse
+/// chamfer term at weight 1.
+const FINE: [(u8, f32, u8, u8, f32); 5] = [
+    (2, 12.0, 12, 16, 0.0),
+    (4, 24.0, 6, 48, 0.0),
+    (1, 8.0, 12, 48, 0.0),
+    (2, 8.0, 12, 48, 0.0),
+    (4, 24.0, 6, 16, 1.0),
 ];
 
 /// `q` scored under each of [`FINE`]: ",mean,worst" per config.
 fn fine_columns(sequence: &Sequence, views: &[FrameView<'_>], q: &[f32]) -> Result<String> {
     let mut out = String::new();
     let mut scorer = StateScorer::new();
-    for &(stride, cap, per_line, grid) in &FINE {
+    for &(stride, cap, per_line, grid, reverse) in &FINE {
         let config = LikelihoodConfig {
             stride_px: stride,
             chamfer_cap_px: cap,
             samples_per_line: per_line,
             silhouette_grid: grid,
+            reverse_weight: reverse,
             ..LikelihoodConfig::default()
         };
         let mut bufs: Vec<Vec<u8>> = sequence
@@ -1089,7 +1099,7 @@ fn main() -> Result<()> {
     let mut csv = match &args.leaves_csv {
         Some(p) => {
             let mut f = std::fs::File::create(p)?;
-            writeln!(f, "run,frame,score,worst_camera,lost,accepted,tip_error_px,f1,f1w,f2,f2w,f3,f3w,f4,f4w")?;
+            writeln!(f, "run,frame,score,worst_camera,lost,accepted,tip_error_px,f1,f1w,f2,f2w,f3,f3w,f4,f4w,rev,revw")?;
             Some(f)
         }
         None => None,

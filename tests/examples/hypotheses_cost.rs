@@ -1,13 +1,14 @@
 //! Tracks a rendered sequence with K hypotheses, for counting instructions per frame under
 //! callgrind (`scripts/hypotheses-instructions` collects only `MultiTracker::track`).
 //!
-//! `cargo run --release -p digiteyes-tests --example hypotheses_cost -- SEQ K FRAMES [EVERY]`
-//! (EVERY: `HypothesesConfig::score_every_frames`, default 1).
+//! `cargo run --release -p digiteyes-tests --example hypotheses_cost -- SEQ K FRAMES [EVERY [REVERSE]]`
+//! (EVERY: `HypothesesConfig::score_every_frames`, default 1; REVERSE: the likelihood's
+//! `reverse_weight`, default the hypotheses' own).
 
 use anyhow::{Context, Result};
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::{HypothesesConfig, MultiTracker};
-use digiteyes_core::likelihood::EdgeMap;
+use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig};
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::track::sequence_tracker;
 use digiteyes_host::TrackerConfig;
@@ -18,11 +19,19 @@ fn main() -> Result<()> {
     let k: u8 = args.get(1).context("SEQ K FRAMES")?.parse()?;
     let frames: usize = args.get(2).context("SEQ K FRAMES")?.parse()?;
     let every: u8 = args.get(3).map_or(Ok(1), |s| s.parse())?;
+    let defaults = HypothesesConfig::default();
+    let reverse: f32 = args
+        .get(4)
+        .map_or(Ok(defaults.likelihood.reverse_weight), |s| s.parse())?;
     let sequence = Sequence::open(std::path::Path::new(seq))?;
     let config = HypothesesConfig {
         count: k,
         score_every_frames: every,
-        ..HypothesesConfig::default()
+        likelihood: LikelihoodConfig {
+            reverse_weight: reverse,
+            ..defaults.likelihood
+        },
+        ..defaults
     };
     let tracker = sequence_tracker(&sequence, TrackerConfig::default())
         .map_err(|e| anyhow::anyhow!("{e}"))?;

@@ -139,7 +139,9 @@ pub struct AcquireConfig {
     pub refine_seeds: u8,
     /// First refinement steps: palm translation (mm), palm rotation (rad), finger bend (rad).
     pub refine_steps: [f32; 3],
-    /// The score.
+    /// The score. Its reverse chamfer term is off by default (and never weighed on the
+    /// coarse levels): the acceptance's bars ([`AcceptConfig`]) are set without it
+    /// (docs/recovery.md, "The reverse chamfer term").
     pub likelihood: LikelihoodConfig,
 }
 
@@ -355,9 +357,12 @@ impl Acquirer {
                 }
             }
             let likelihood = match self.stage {
+                // The coarse levels only order the tree's nodes: no reverse term, whose cost
+                // would multiply with their many hypotheses.
                 Stage::Coarse(_) => LikelihoodConfig {
                     samples_per_line: self.config.coarse_sampling[0],
                     silhouette_grid: self.config.coarse_sampling[1],
+                    reverse_weight: 0.0,
                     ..self.config.likelihood
                 },
                 _ => self.config.likelihood,
@@ -533,8 +538,19 @@ impl Acquirer {
     /// posed).
     pub fn score_cameras(&mut self, scene: &Scene<'_>, q: &[f32; MAX_STATES]) -> (f32, f32) {
         let config = self.config.likelihood;
+        self.score_cameras_under(scene, q, &config)
+    }
+
+    /// [`Self::score_cameras`] under another likelihood `config` (whose edge maps `scene`
+    /// holds).
+    pub fn score_cameras_under(
+        &mut self,
+        scene: &Scene<'_>,
+        q: &[f32; MAX_STATES],
+        config: &LikelihoodConfig,
+    ) -> (f32, f32) {
         self.scratch
-            .score_cameras(scene, &q[..self.n_states], &config)
+            .score_cameras(scene, &q[..self.n_states], config)
     }
 
     /// The likelihood of `q` in each camera into `out`; returns how many were scored (0 when

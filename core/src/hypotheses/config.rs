@@ -94,9 +94,15 @@ pub struct HypothesesConfig {
     /// A scored frame costs the edge map of every camera, the samples' tracking and the
     /// scores: most of what K > 1 adds to a frame (docs/hypotheses.md).
     pub score_every_frames: u8,
-    /// The image likelihood that scores them.
+    /// The image likelihood that scores them (with the reverse chamfer term at
+    /// [`HYPOTHESES_REVERSE_WEIGHT`] by default).
     pub likelihood: LikelihoodConfig,
 }
+
+/// The weight of the reverse chamfer term (edges near the hand no model line explains) in
+/// the hypotheses' likelihood: measured on the robustness sweep, it ranks a frame's
+/// hypotheses nearer the truth (docs/hypotheses.md, "The reverse chamfer term").
+pub const HYPOTHESES_REVERSE_WEIGHT: f32 = 0.8;
 
 impl HypothesesConfig {
     /// `count` clamped to 1..=[`MAX_HYPOTHESES`].
@@ -140,7 +146,10 @@ impl Default for HypothesesConfig {
             motion_weight: 0.05,
             score_memory: 0.0,
             score_every_frames: 1,
-            likelihood: LikelihoodConfig::default(),
+            likelihood: LikelihoodConfig {
+                reverse_weight: HYPOTHESES_REVERSE_WEIGHT,
+                ..LikelihoodConfig::default()
+            },
         }
     }
 }

@@ -17,12 +17,14 @@ use crate::projection::ProjectedModel;
 
 mod edges;
 mod region;
+mod reverse;
 mod samples;
 mod scene;
 mod state;
 
 pub use edges::{BuiltEdges, EdgeMap, EDGE_BINS, GRADIENT_STEP_PX};
 pub use region::{Region, EXTENT_PERCENTILE, MAX_EXTENT_BINS, MIN_REGION_SAMPLES};
+pub use reverse::MAX_REVERSE_CELLS;
 use samples::ChamferSum;
 pub use samples::{visit, Samples, SilhouettePoint, MAX_SAMPLES, MAX_SAMPLES_PER_LINE};
 pub use scene::Scene;
@@ -46,6 +48,13 @@ pub struct LikelihoodConfig {
     /// Weight of the silhouette term in [`Likelihood::score`] (0..=1); the chamfer term has
     /// the rest.
     pub silhouette_weight: f32,
+    /// Weight of the [reverse chamfer term](reverse): the score loses this much times the
+    /// term over its cap (0, the default, leaves it out and computes nothing).
+    pub reverse_weight: f32,
+    /// Reverse distances are truncated here (px).
+    pub reverse_cap_px: f32,
+    /// The reverse term's edge cells lie within the hand's image bounds widened by this (px).
+    pub reverse_margin_px: f32,
 }
 
 impl Default for LikelihoodConfig {
@@ -57,6 +66,9 @@ impl Default for LikelihoodConfig {
             samples_per_line: 6,
             silhouette_grid: 16,
             silhouette_weight: 0.4,
+            reverse_weight: 0.0,
+            reverse_cap_px: 12.0,
+            reverse_margin_px: 8.0,
         }
     }
 }
@@ -102,8 +114,11 @@ pub struct Likelihood {
     pub points_hidden: u16,
     /// The silhouette's agreement with the image (0..=1), when it could be scored.
     pub silhouette: Option<f32>,
+    /// The reverse chamfer term (px), when weighed and an edge lay near the hand.
+    pub reverse_px: Option<f32>,
     /// The combined score (0..=1, higher is better): `1 − chamfer/cap` and the silhouette
-    /// agreement, weighted by [`LikelihoodConfig::silhouette_weight`].
+    /// agreement, weighted by [`LikelihoodConfig::silhouette_weight`], less
+    /// [`LikelihoodConfig::reverse_weight`] times the reverse term over its cap (floored at 0).
     pub score: f32,
 }
 
@@ -119,7 +134,28 @@ pub fn evaluate(
 ) -> Likelihood {
     let mut likelihood = evaluate_edges(view, camera, edges, config);
     add_silhouette(&mut likelihood, view, camera, frame, config);
+    add_reverse(&mut likelihood, view, edges, config);
     likelihood
+}
+
+/// Lowers `likelihood`'s score by the reverse chamfer term, when it is weighed and the
+/// view has points in the frame. Only lowers it, so every bound on the score stays one.
+pub(crate) fn add_reverse(
+    likelihood: &mut Likelihood,
+    view: &ProjectedModel,
+    edges: &EdgeMap<'_>,
+    config: &LikelihoodConfig,
+) {
+    let weight = config.reverse_weight;
+    let weighed = weight > 0.0;
+    if !weighed || likelihood.points == 0 {
+        return;
+    }
+    likelihood.reverse_px = reverse::reverse_px(view, edges, config);
+    if let Some(px) = likelihood.reverse_px {
+        let term = (px / config.reverse_cap_px.max(1e-3)).clamp(0.0, 1.0);
+        likelihood.score = (likelihood.score - weight * term).max(0.0);
+    }
 }
 
 /// The chamfer half of [`evaluate`]: every field but the silhouette's, and a `score` that
@@ -151,6 +187,7 @@ pub(crate) fn evaluate_edges(
         points_outside: outside,
         points_hidden: hidden,
         silhouette: None,
+        reverse_px: None,
         score: combine(edge_term(chamfer_px, config), Some(1.0), config),
     }
 }

@@ -10,7 +10,8 @@ use crate::model::Model;
 use crate::projection::ProjectedModel;
 
 use super::{
-    add_silhouette, ceiling, evaluate, evaluate_edges, Likelihood, LikelihoodConfig, Scene,
+    add_reverse, add_silhouette, ceiling, evaluate, evaluate_edges, Likelihood, LikelihoodConfig,
+    Scene,
 };
 
 /// Shortest link drawn when scoring (px): the tracker's own default.
@@ -131,6 +132,7 @@ impl StateScorer {
             }
             if each[k].points > 0 {
                 add_silhouette(&mut each[k], &self.view, camera, frame, config);
+                add_reverse(&mut each[k], &self.view, edges, config);
                 out.silhouette_terms += 1;
             }
         }

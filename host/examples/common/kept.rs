@@ -103,6 +103,18 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "jturn" => o.hypotheses.jump_min_turn_rad = f,
             "jpx" => o.hypotheses.jump_max_moved_px = f,
             "mw" => o.hypotheses.motion_weight = f,
+            "rev" => o.hypotheses.likelihood.reverse_weight = f,
+            "arev" => o.acquire.likelihood.reverse_weight = f,
+            "wrev" => o.watch.reverse_weight = f,
+            "accm" => {
+                o.finder.accept.min_score = f;
+                o.finder.accept.min_camera_score = f;
+            }
+            "acc1" => o.finder.accept.one_camera_score = f,
+            "revcap" => {
+                o.hypotheses.likelihood.reverse_cap_px = f;
+                o.acquire.likelihood.reverse_cap_px = f;
+            }
             "step" => o.hypotheses.spawn_step = f,
             "k" => o.hypotheses.count = f as u8,
             "smem" => o.hypotheses.score_memory = f,
