@@ -14,10 +14,20 @@ use digiteyes_host::sequence::Sequence;
 mod common;
 
 fn score(sequence: &Sequence, k: usize, q: &[f32], blank: bool) -> Likelihood {
-    let config = LikelihoodConfig::default();
+    score_under(sequence, k, q, blank, &LikelihoodConfig::default())
+}
+
+/// The likelihood of `q` at frame `k` of camera 0 under `config`; with `blank`, of the
+/// background alone (the first pixel's grey everywhere).
+fn score_under(
+    sequence: &Sequence,
+    k: usize,
+    q: &[f32],
+    blank: bool,
+    config: &LikelihoodConfig,
+) -> Likelihood {
     let mut image = sequence.read_frame(0, k).unwrap();
     if blank {
-        // The background alone: the first pixel's grey everywhere.
         let grey = image.as_raw()[0];
         image.as_mut().fill(grey);
     }
@@ -29,12 +39,12 @@ fn score(sequence: &Sequence, k: usize, q: &[f32], blank: bool) -> Likelihood {
     .unwrap();
     let mut buffer =
         vec![0u8; EdgeMap::bytes_needed(frame.width(), frame.height(), config.stride_px)];
-    let edges = EdgeMap::build(&mut buffer, &frame, &config).unwrap();
+    let edges = EdgeMap::build(&mut buffer, &frame, config).unwrap();
     let camera = &sequence.cameras[0];
     let poses = Poses::compute(&sequence.model, q).unwrap();
     let mut view = ProjectedModel::new();
     view.update(&sequence.model, &poses, camera, 4.0);
-    evaluate(&view, camera, &frame, &edges, &config)
+    evaluate(&view, camera, &frame, &edges, config)
 }
 
 /// The true state of `sequence`'s first frame.
@@ -390,7 +400,8 @@ fn a_finger_bent_off_its_edges_leaves_them_unexplained() {
         let camera = &sequence.cameras[0];
         for k in [0, 10, 19] {
             let q: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
-            let at_truth = score_under(&sequence, k, &q, &config);
+            let at_truth = score_under(&sequence, k, &q, false, &config);
+            let plain_truth = score_under(&sequence, k, &q, false, &plain).score;
             let truth_poses = Poses::compute(&sequence.model, &q).unwrap();
             for (joints, tip) in fingers(&sequence) {
                 let mut bent = q.clone();
@@ -409,16 +420,16 @@ fn a_finger_bent_off_its_edges_leaves_them_unexplained() {
                 if moved <= 10.0 {
                     continue;
                 }
-                let other = score_under(&sequence, k, &bent, &config);
+                let other = score_under(&sequence, k, &bent, false, &config);
                 let (Some(t), Some(o)) = (at_truth.reverse_px, other.reverse_px) else {
                     continue;
                 };
                 cases += 1;
                 higher += usize::from(o > t);
                 score_lower += usize::from(other.score < at_truth.score);
-                let plain_truth = score_under(&sequence, k, &q, &plain).score;
-                plain_lower +=
-                    usize::from(score_under(&sequence, k, &bent, &plain).score < plain_truth);
+                plain_lower += usize::from(
+                    score_under(&sequence, k, &bent, false, &plain).score < plain_truth,
+                );
             }
         }
     }
@@ -437,23 +448,4 @@ fn a_finger_bent_off_its_edges_leaves_them_unexplained() {
         score_lower >= plain_lower && score_lower * 100 >= cases * 95,
         "lower on {score_lower} of {cases} with the term, {plain_lower} without"
     );
-}
-
-/// The likelihood of `q` at frame `k` of camera 0 under `config`.
-fn score_under(sequence: &Sequence, k: usize, q: &[f32], config: &LikelihoodConfig) -> Likelihood {
-    let image = sequence.read_frame(0, k).unwrap();
-    let frame = FrameView::packed(
-        image.as_raw(),
-        image.width() as usize,
-        image.height() as usize,
-    )
-    .unwrap();
-    let mut buffer =
-        vec![0u8; EdgeMap::bytes_needed(frame.width(), frame.height(), config.stride_px)];
-    let edges = EdgeMap::build(&mut buffer, &frame, config).unwrap();
-    let camera = &sequence.cameras[0];
-    let poses = Poses::compute(&sequence.model, q).unwrap();
-    let mut view = ProjectedModel::new();
-    view.update(&sequence.model, &poses, camera, 4.0);
-    evaluate(&view, camera, &frame, &edges, config)
 }
