@@ -535,8 +535,10 @@ impl AutoTracker {
         }
         if !report.lost && self.recovery == Recovery::Search && self.watch.due() {
             // The probation's score is the search's: reused only when the watch scores alike.
+            let scores_alike = self.watch.config().reverse_weight
+                == self.finder.acquirer().config().likelihood.reverse_weight;
             let worst = match watch_score {
-                Some(worst) if !self.watch.weighs_reverse() => worst,
+                Some(worst) if scores_alike => worst,
                 _ => self.watch_score(frames, edge_buffers, &built)?,
             };
             watch_score = Some(worst);

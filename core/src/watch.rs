@@ -89,11 +89,6 @@ impl Watch {
         &self.config
     }
 
-    /// Whether the checks weigh the reverse chamfer term (a positive weight; not NaN).
-    pub fn weighs_reverse(&self) -> bool {
-        self.config.reverse_weight > 0.0
-    }
-
     /// A check falls due every this many tracking frames (0: never).
     pub fn period_frames(&self) -> u16 {
         self.period_frames
