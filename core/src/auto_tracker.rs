@@ -45,8 +45,8 @@ use core::fmt;
 use heapless::Vec;
 
 use crate::acquire::{
-    AcceptConfig, AcquireConfig, Acquirer, Finder, FinderConfig, FinderStep, WorkingVolume,
-    DEPTH_VARIANTS, LOCAL_VARIANTS, MAX_KEEP,
+    AcceptConfig, AcquireConfig, Acquirer, Finder, FinderConfig, FinderStep, LeafScore,
+    WorkingVolume, DEPTH_VARIANTS, LOCAL_VARIANTS, MAX_KEEP,
 };
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_HYPOTHESES, MAX_STATES};
@@ -202,13 +202,26 @@ struct Probation {
 }
 
 /// A hypothesis refined on this frame: its state, its mean and worst camera's likelihood
-/// score, and the tracker's report of its last pass.
+/// score (and reverse term, when the acceptance asks for it), and the tracker's report of
+/// its last pass.
 #[derive(Clone, Copy)]
 struct Refined {
     score: f32,
     worst_camera: f32,
+    reverse_px: Option<f32>,
     q: [f32; MAX_STATES],
     report: FrameReport,
+}
+
+impl Refined {
+    /// What the acceptance reads of it.
+    fn leaf(&self) -> LeafScore {
+        LeafScore {
+            score: self.score,
+            worst_camera: self.worst_camera,
+            reverse_px: self.reverse_px,
+        }
+    }
 }
 
 /// Where a start of the local re-acquisition comes from.
@@ -943,9 +956,7 @@ impl AutoTracker {
         out.leaf_score = Some(score);
         let finder = *self.finder.config();
         let cameras = self.multi.tracker().cameras().len();
-        let verdict = finder
-            .accept
-            .judge(cameras, score, best.worst_camera, report.lost);
+        let verdict = finder.accept.judge(cameras, best.leaf(), report.lost);
         if verdict.accepted {
             let mut others: Vec<[f32; MAX_STATES], 3> = Vec::new();
             for r in refined.iter().skip(1) {
@@ -1011,6 +1022,7 @@ impl AutoTracker {
                 return Ok(Refined {
                     score: 0.0,
                     worst_camera: 0.0,
+                    reverse_px: None,
                     q,
                     report,
                 });
@@ -1018,10 +1030,16 @@ impl AutoTracker {
         }
         let tracker = self.multi.tracker();
         let scene = Scene::new(tracker.model(), tracker.cameras(), frames, maps);
-        let (score, worst_camera) = self.finder.acquirer_mut().score_cameras(&scene, &q);
+        let accept = self.finder.config().accept;
+        let LeafScore {
+            score,
+            worst_camera,
+            reverse_px,
+        } = self.finder.acquirer_mut().leaf_score(&scene, &q, &accept);
         Ok(Refined {
             score,
             worst_camera,
+            reverse_px,
             q,
             report,
         })
@@ -1044,9 +1062,7 @@ impl AutoTracker {
         out.evaluated = out.evaluated.saturating_add(1);
         let finder = *self.finder.config();
         let cameras = self.multi.tracker().cameras().len();
-        let verdict = finder
-            .accept
-            .judge(cameras, r.score, r.worst_camera, r.report.lost);
+        let verdict = finder.accept.judge(cameras, r.leaf(), r.report.lost);
         let rig = usize::from(cameras < 2);
         if verdict.accepted {
             self.finder.restart();

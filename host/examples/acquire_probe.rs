@@ -147,6 +147,13 @@ struct Args {
     /// The score a leaf needs with one camera.
     #[arg(long)]
     one_camera_score: Option<f32>,
+    /// The acceptance's bar on the worst camera's reverse chamfer term with two cameras (px;
+    /// a large finite value computes it for `--leaves-csv` without refusing anything).
+    #[arg(long)]
+    max_reverse_px: Option<f32>,
+    /// The same with one camera (px).
+    #[arg(long)]
+    one_camera_max_reverse_px: Option<f32>,
     /// The robust weight leaves are refined under: `huber=K`, `tukey=C` (px) or `none`.
     #[arg(long)]
     leaf_robust: Option<String>,
@@ -292,6 +299,10 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             min_score: args.min_score.unwrap_or(f.accept.min_score),
             min_camera_score: args.min_camera_score.unwrap_or(f.accept.min_camera_score),
             one_camera_score: args.one_camera_score.unwrap_or(f.accept.one_camera_score),
+            max_reverse_px: args.max_reverse_px.unwrap_or(f.accept.max_reverse_px),
+            one_camera_max_reverse_px: args
+                .one_camera_max_reverse_px
+                .unwrap_or(f.accept.one_camera_max_reverse_px),
         },
         replace_leaves: args.replace.unwrap_or(f.replace_leaves),
         confirm_frames: args.confirm_frames.unwrap_or(f.confirm_frames),
@@ -708,11 +719,14 @@ fn run(
                 let fine = fine_columns(sequence, &views, &q[..n])?;
                 writeln!(
                     f,
-                    "{label},{k},{:.4},{:.4},{},{},{e:.2}{fine}",
+                    "{label},{k},{:.4},{:.4},{},{},{e:.2}{fine},{}",
                     verdict.score,
                     verdict.worst_camera,
                     u8::from(verdict.lost),
-                    u8::from(verdict.accepted)
+                    u8::from(verdict.accepted),
+                    verdict
+                        .reverse_px
+                        .map_or(String::new(), |px| format!("{px:.2}"))
                 )?;
             }
         }
@@ -1036,11 +1050,14 @@ fn hand_free_run(sequence: &Sequence, args: &Args, csv: &mut Option<std::fs::Fil
                     let fine = fine_columns(sequence, &views, &q[..sequence.n_states()])?;
                     writeln!(
                         f,
-                        "hand-free-{kind}-{},{k},{:.4},{:.4},{},0,inf{fine}",
+                        "hand-free-{kind}-{},{k},{:.4},{:.4},{},0,inf{fine},{}",
                         sequence.cameras.len(),
                         verdict.score,
                         verdict.worst_camera,
-                        u8::from(verdict.lost)
+                        u8::from(verdict.lost),
+                        verdict
+                            .reverse_px
+                            .map_or(String::new(), |px| format!("{px:.2}"))
                     )?;
                 }
                 break;
@@ -1099,7 +1116,7 @@ fn main() -> Result<()> {
     let mut csv = match &args.leaves_csv {
         Some(p) => {
             let mut f = std::fs::File::create(p)?;
-            writeln!(f, "run,frame,score,worst_camera,lost,accepted,tip_error_px,f1,f1w,f2,f2w,f3,f3w,f4,f4w,rev,revw")?;
+            writeln!(f, "run,frame,score,worst_camera,lost,accepted,tip_error_px,f1,f1w,f2,f2w,f3,f3w,f4,f4w,rev,revw,reverse_px")?;
             Some(f)
         }
         None => None,

@@ -238,6 +238,7 @@ fn a_frame_of_leaves_after_work_elsewhere_refines_one_leaf_fewer() {
                 min_score: 2.0,
                 min_camera_score: 2.0,
                 one_camera_score: 2.0,
+                ..AcceptConfig::default()
             },
             ..FinderConfig::default()
         };
@@ -320,11 +321,13 @@ fn the_hand_is_acquired_from_nothing_on_rigs_the_sweep_acquires() {
     // weight 1 with the class margin, 9 of the 40 mono tuning seeds are acquired at 5 px as
     // before, but 134 is no longer one of them, and 136, acquired either way, takes its place;
     // 22 of the 40 stereo ones before frame 10 as before, but not 107 and 108, and 111 and
-    // 112 take their places.)
+    // 112 take their places. Since one camera's acceptance bars a reverse chamfer term over
+    // 3.5 px, 136's leaves, 4.8 px off, leave 4.0 px of the image's edges unexplained and
+    // are refused; 104 takes its place.)
     let dir = tempfile::tempdir().unwrap();
     for (rig, seed, before) in [
         ("random-mono", 113, 30),
-        ("random-mono", 136, 30),
+        ("random-mono", 104, 30),
         ("random-stereo", 111, 10),
         ("random-stereo", 113, 10),
         ("random-stereo", 104, 10),
@@ -353,7 +356,10 @@ fn leaves_are_refined_under_the_searchs_robust_weight_not_the_trackers() {
     // `random-mono` seed 133 (docs/robustness.md). Leaves are refined under
     // `FinderConfig::leaf_robust` (Huber 2 px), so a Tukey tracker still acquires. (Since the
     // sweep's lighting is varied, 133 is not acquired at 5 px under either weight; 134 was,
-    // until the region rows' weight 1; 136 is.)
+    // until the region rows' weight 1; 136 was, until one camera's acceptance barred a
+    // reverse chamfer term over 3.5 px; with that bar 134 is again, and is not with its
+    // leaves refined under Tukey 5 px, checked by hand: `acquire_probe --seeds 134..=134
+    // --rigs mono --limit-px 10 --leaf-robust tukey=5`.)
     let dir = tempfile::tempdir().unwrap();
     let mut tukey = TrackerConfig::default();
     tukey.estimator.robust = Robust::Tukey(5.0);
@@ -361,14 +367,14 @@ fn leaves_are_refined_under_the_searchs_robust_weight_not_the_trackers() {
     let (good, line) = acquisition(
         dir.path(),
         "random-mono",
-        136,
+        134,
         tukey,
         FinderConfig::default(),
     );
-    println!("random-mono 136 under Tukey 5 px: {line}");
+    println!("random-mono 134 under Tukey 5 px: {line}");
     assert!(
         acquired_before(&good, 30).is_some(),
-        "random-mono 136 was not acquired before frame 30 under Tukey: {line}"
+        "random-mono 134 was not acquired before frame 30 under Tukey: {line}"
     );
 }
 

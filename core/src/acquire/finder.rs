@@ -14,7 +14,7 @@ use crate::likelihood::{EdgeMap, Scene};
 use crate::motion::PriorWeights;
 use crate::tracker::{FrameReport, RefineOverrides, Tracker, TrackerConfig, TrackerError};
 
-use super::accept::{AcceptConfig, Verdict};
+use super::accept::{AcceptConfig, LeafScore, Verdict};
 use super::{Acquirer, Progress, MAX_KEEP};
 
 /// How leaves are refined and judged.
@@ -510,18 +510,17 @@ impl Finder {
         for (d, s) in q.iter_mut().zip(tracker.state()) {
             *d = *s;
         }
-        let (score, worst) = if report.lost {
-            (0.0, 0.0)
+        let accept = self.config.accept;
+        let leaf = if report.lost {
+            LeafScore::default()
         } else {
             let cameras = tracker.cameras();
             let n_cameras = cameras.len().min(MAX_CAMERAS);
             let scene = Scene::new(tracker.model(), &cameras[..n_cameras], frames, edges);
-            self.acquirer.score_cameras(&scene, &q)
+            self.acquirer.leaf_score(&scene, &q, &accept)
         };
         Ok((
-            self.config
-                .accept
-                .judge(tracker.cameras().len(), score, worst, report.lost),
+            accept.judge(tracker.cameras().len(), leaf, report.lost),
             q,
             report,
         ))

@@ -39,7 +39,7 @@ pub mod place;
 mod rotation;
 mod volume;
 
-pub use accept::{AcceptConfig, Verdict};
+pub use accept::{AcceptConfig, LeafScore, Verdict};
 pub use finder::{Finder, FinderConfig, FinderStep, DEPTH_VARIANTS, LOCAL_TURN_RAD};
 pub use library::{FingerPose, POSE_COUNT};
 pub use place::{triangulate, Depth};
@@ -539,6 +539,29 @@ impl Acquirer {
     pub fn score_cameras(&mut self, scene: &Scene<'_>, q: &[f32; MAX_STATES]) -> (f32, f32) {
         let config = self.config.likelihood;
         self.score_cameras_under(scene, q, &config)
+    }
+
+    /// What `accept` reads of a refined leaf `q`: its mean and worst camera's score, and its
+    /// worst camera's reverse chamfer term when `accept` has a bar on it for this rig.
+    pub fn leaf_score(
+        &mut self,
+        scene: &Scene<'_>,
+        q: &[f32; MAX_STATES],
+        accept: &AcceptConfig,
+    ) -> LeafScore {
+        let (score, worst_camera) = self.score_cameras(scene, q);
+        let reverse_px = if accept.weighs_reverse(scene.cameras.len()) {
+            let config = self.config.likelihood;
+            self.scratch
+                .worst_reverse_px(scene, &q[..self.n_states], &config)
+        } else {
+            None
+        };
+        LeafScore {
+            score,
+            worst_camera,
+            reverse_px,
+        }
     }
 
     /// [`Self::score_cameras`] under another likelihood `config` (whose edge maps `scene`

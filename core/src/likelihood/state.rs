@@ -10,8 +10,8 @@ use crate::model::Model;
 use crate::projection::ProjectedModel;
 
 use super::{
-    add_reverse, add_silhouette, ceiling, evaluate, evaluate_edges, Likelihood, LikelihoodConfig,
-    Scene,
+    add_reverse, add_silhouette, ceiling, evaluate, evaluate_edges, reverse, Likelihood,
+    LikelihoodConfig, Scene,
 };
 
 /// Shortest link drawn when scoring (px): the tracker's own default.
@@ -158,6 +158,31 @@ impl StateScorer {
             .map(|l| l.score)
             .fold(f32::INFINITY, f32::min);
         (mean_score(&each[..n]), worst)
+    }
+
+    /// The largest [reverse chamfer term](super::reverse) of `q` over the cameras (px,
+    /// 0..=`reverse_cap_px`), whatever `config`'s `reverse_weight`: how far the worst view's
+    /// edges near the hand lie from the lines that would explain them. `None` when `q` cannot
+    /// be posed or no camera has an edge near the projected hand.
+    pub fn worst_reverse_px(
+        &mut self,
+        scene: &Scene<'_>,
+        q: &[f32],
+        config: &LikelihoodConfig,
+    ) -> Option<f32> {
+        if !self.pose(scene.model, q) {
+            return None;
+        }
+        let mut worst: Option<f32> = None;
+        for (camera, edges) in scene.cameras.iter().zip(scene.edges) {
+            if !self.project(scene.model, camera) {
+                return None;
+            }
+            if let Some(px) = reverse::reverse_px(&self.view, edges, config) {
+                worst = Some(worst.map_or(px, |w| w.max(px)));
+            }
+        }
+        worst
     }
 
     /// The mean likelihood score of `q` over the cameras (0..=1, higher is better); 0 when

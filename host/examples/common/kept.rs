@@ -111,6 +111,8 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
                 o.finder.accept.min_camera_score = f;
             }
             "acc1" => o.finder.accept.one_camera_score = f,
+            "arx" => o.finder.accept.max_reverse_px = f,
+            "arx1" => o.finder.accept.one_camera_max_reverse_px = f,
             "revcap" => {
                 o.hypotheses.likelihood.reverse_cap_px = f;
                 o.acquire.likelihood.reverse_cap_px = f;
