@@ -547,15 +547,17 @@ impl AutoTracker {
             return Ok(self.search_again(multi, 0, None));
         }
         if !report.lost && self.recovery == Recovery::Search && self.watch.due() {
-            // The probation's score is the search's: reused only when the watch scores alike.
+            // The probation's score is the search's: reused only when the watch scores alike
+            // and reads nothing more.
             let scores_alike = self.watch.config().reverse_weight
-                == self.finder.acquirer().config().likelihood.reverse_weight;
-            let worst = match watch_score {
-                Some(worst) if scores_alike => worst,
-                _ => self.watch_score(frames, edge_buffers, &built)?,
+                == self.finder.acquirer().config().likelihood.reverse_weight
+                && !self.watch.weighs_reverse();
+            let (worst, reverse_px) = match watch_score {
+                Some(worst) if scores_alike => (worst, None),
+                _ => self.watch_check(frames, edge_buffers, &built)?,
             };
             watch_score = Some(worst);
-            if self.watch.judge(worst) {
+            if self.watch.judge(worst, reverse_px) {
                 self.vouched = self.multi.tracker().memory().state;
             } else {
                 // The image does not support the track: a lost frame, and what was last
@@ -634,42 +636,50 @@ impl AutoTracker {
         built: &[BuiltEdges],
     ) -> Result<f32, AutoError> {
         let likelihood = self.finder.acquirer().config().likelihood;
-        self.worst_camera_score_under(frames, edge_buffers, built, &likelihood)
+        let (worst, _) =
+            self.worst_camera_score_under(frames, edge_buffers, built, &likelihood, false)?;
+        Ok(worst)
     }
 
-    /// [`Self::worst_camera_score`] under the watch's likelihood: the search's, with the
-    /// watch's weight of the reverse term.
-    fn watch_score(
+    /// What a check of the watch reads of the tracked state: its worst camera score under the
+    /// watch's likelihood (the search's, with the watch's weight of the reverse term), and
+    /// its worst camera's reverse term when the watch has a bar on it.
+    fn watch_check(
         &mut self,
         frames: &[FrameView<'_>],
         edge_buffers: &mut [&mut [u8]],
         built: &[BuiltEdges],
-    ) -> Result<f32, AutoError> {
+    ) -> Result<(f32, Option<f32>), AutoError> {
         let likelihood = LikelihoodConfig {
             reverse_weight: self.watch.config().reverse_weight,
             ..self.finder.acquirer().config().likelihood
         };
-        self.worst_camera_score_under(frames, edge_buffers, built, &likelihood)
+        let reverse = self.watch.weighs_reverse();
+        self.worst_camera_score_under(frames, edge_buffers, built, &likelihood, reverse)
     }
 
     /// The tracked state's worst camera score under `likelihood` (whose edge maps are the
-    /// search's).
+    /// search's), and its worst camera's reverse term if `reverse` asks for it.
     fn worst_camera_score_under(
         &mut self,
         frames: &[FrameView<'_>],
         edge_buffers: &mut [&mut [u8]],
         built: &[BuiltEdges],
         likelihood: &LikelihoodConfig,
-    ) -> Result<f32, AutoError> {
+        reverse: bool,
+    ) -> Result<(f32, Option<f32>), AutoError> {
         let maps = reopened_edge_maps(edge_buffers, frames, likelihood, built)?;
         let tracker = self.multi.tracker();
         let q = padded(tracker.state());
         let scene = Scene::new(tracker.model(), tracker.cameras(), frames, &maps);
-        let (_, worst) = self
-            .finder
-            .acquirer_mut()
-            .score_cameras_under(&scene, &q, likelihood);
-        Ok(worst)
+        let acquirer = self.finder.acquirer_mut();
+        let (_, worst) = acquirer.score_cameras_under(&scene, &q, likelihood);
+        let reverse_px = if reverse {
+            acquirer.worst_reverse_px(&scene, &q)
+        } else {
+            None
+        };
+        Ok((worst, reverse_px))
     }
 
     /// Keeps the tracker's state as the last that claimed the hand.

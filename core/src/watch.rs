@@ -42,6 +42,11 @@ pub struct WatchConfig {
     /// ([`LikelihoodConfig::reverse_weight`](crate::likelihood::LikelihoodConfig)); 0, the
     /// default, leaves it out. The search's likelihood is otherwise the watch's.
     pub reverse_weight: f32,
+    /// A check also fails when the tracked state leaves more than this of the [reverse
+    /// chamfer term](crate::likelihood) in its worst camera (px: the mean distance from the
+    /// edges near the hand to the nearest line of it that could explain them);
+    /// `f32::INFINITY`, the default, asks nothing of it and computes nothing.
+    pub max_reverse_px: f32,
 }
 
 impl Default for WatchConfig {
@@ -50,6 +55,7 @@ impl Default for WatchConfig {
             every_frames: 8,
             max_drop: 0.10,
             reverse_weight: 0.0,
+            max_reverse_px: f32::INFINITY,
         }
     }
 }
@@ -108,11 +114,19 @@ impl Watch {
         self.reference
     }
 
-    /// Takes a check's worst camera score; returns whether the state passed. The track's
-    /// first finite score becomes its reference and passes.
-    pub fn judge(&mut self, worst_camera_score: f32) -> bool {
+    /// Whether a check reads the reverse chamfer term (a finite
+    /// [`WatchConfig::max_reverse_px`]): only then need a caller compute it.
+    pub fn weighs_reverse(&self) -> bool {
+        self.config.max_reverse_px.is_finite()
+    }
+
+    /// Takes a check's worst camera score and reverse term (px; `None` when not computed or
+    /// no edge lay near the hand); returns whether the state passed. The track's first finite
+    /// score becomes its reference and passes, unless its reverse term is over the bar.
+    pub fn judge(&mut self, worst_camera_score: f32, reverse_px: Option<f32>) -> bool {
         self.since_check = 0;
-        let passed = worst_camera_score.is_finite()
+        let explains_its_edges = reverse_px.is_none_or(|px| px <= self.config.max_reverse_px);
+        let scored = worst_camera_score.is_finite()
             && match self.reference {
                 None => {
                     self.reference = Some(worst_camera_score);
@@ -120,6 +134,7 @@ impl Watch {
                 }
                 Some(reference) => worst_camera_score >= reference - self.config.max_drop,
             };
+        let passed = scored && explains_its_edges;
         self.doubted = !passed;
         passed
     }
@@ -164,12 +179,12 @@ mod tests {
     fn the_first_frame_sets_the_reference_then_a_check_falls_due_every_n_frames() {
         let mut w = every(3);
         assert!(w.due());
-        assert!(w.judge(0.9));
+        assert!(w.judge(0.9, None));
         assert_eq!(w.reference(), Some(0.9));
         let due: [bool; 6] = core::array::from_fn(|_| {
             let d = w.due();
             if d {
-                assert!(w.judge(0.85));
+                assert!(w.judge(0.85, None));
             }
             d
         });
@@ -179,32 +194,32 @@ mod tests {
     #[test]
     fn a_drop_beyond_the_margin_fails_and_is_checked_every_frame_until_a_pass() {
         let mut w = every(4);
-        assert!(w.due() && w.judge(0.95));
+        assert!(w.due() && w.judge(0.95, None));
         assert!(!w.due() && !w.due() && !w.due() && w.due());
-        assert!(!w.judge(0.84));
+        assert!(!w.judge(0.84, None));
         assert!(w.doubted());
-        assert!(w.due() && !w.judge(f32::NAN));
-        assert!(w.due() && w.judge(0.86));
+        assert!(w.due() && !w.judge(f32::NAN, None));
+        assert!(w.due() && w.judge(0.86, None));
         assert!(!w.doubted() && !w.due());
     }
 
     #[test]
     fn clearing_forgets_the_doubt_and_keeps_the_reference() {
         let mut w = every(4);
-        assert!(w.due() && w.judge(0.95));
+        assert!(w.due() && w.judge(0.95, None));
         w.due();
-        assert!(!w.judge(0.5));
+        assert!(!w.judge(0.5, None));
         w.clear();
         assert!(!w.doubted() && !w.due());
         assert_eq!(w.reference(), Some(0.95));
         assert!(!w.due() && !w.due() && w.due());
-        assert!(!w.judge(0.6));
+        assert!(!w.judge(0.6, None));
     }
 
     #[test]
     fn a_nan_first_score_sets_no_reference() {
         let mut w = every(4);
-        assert!(w.due() && !w.judge(f32::NAN));
+        assert!(w.due() && !w.judge(f32::NAN, None));
         assert!(w.reference().is_none() && w.due());
     }
 
@@ -212,5 +227,40 @@ mod tests {
     fn a_watch_every_zero_frames_never_checks() {
         let mut w = every(0);
         assert!((0..100).all(|_| !w.due()));
+    }
+
+    #[test]
+    fn edges_left_unexplained_fail_a_check_only_under_a_finite_bar() {
+        let mut plain = every(1);
+        assert!(!plain.weighs_reverse());
+        assert!(plain.due() && plain.judge(0.95, Some(9.0)));
+        let mut barred = Watch::new(
+            WatchConfig {
+                every_frames: 1,
+                max_reverse_px: 4.0,
+                ..WatchConfig::default()
+            },
+            WATCH_REFERENCE_PIXELS,
+        );
+        assert!(barred.weighs_reverse());
+        assert!(barred.due() && barred.judge(0.95, Some(3.0)));
+        assert!(
+            barred.due() && !barred.judge(0.95, Some(4.5)),
+            "over the bar"
+        );
+        assert!(
+            barred.doubted() && barred.due(),
+            "in doubt: checked every frame"
+        );
+        assert!(
+            barred.judge(0.95, None),
+            "no edge near the hand: nothing against it"
+        );
+        assert!(barred.due() && !barred.judge(0.95, Some(f32::NAN)));
+        assert!(
+            barred.due() && !barred.judge(0.80, Some(3.0)),
+            "the score still counts"
+        );
+        assert_eq!(barred.reference(), Some(0.95));
     }
 }

@@ -551,9 +551,7 @@ impl Acquirer {
     ) -> LeafScore {
         let (score, worst_camera) = self.score_cameras(scene, q);
         let reverse_px = if accept.weighs_reverse(scene.cameras.len()) {
-            let config = self.config.likelihood;
-            self.scratch
-                .worst_reverse_px(scene, &q[..self.n_states], &config)
+            self.worst_reverse_px(scene, q)
         } else {
             None
         };
@@ -562,6 +560,14 @@ impl Acquirer {
             worst_camera,
             reverse_px,
         }
+    }
+
+    /// The largest reverse chamfer term of `q` over the cameras (px), under the search's
+    /// likelihood whatever its `reverse_weight` ([`crate::likelihood::StateScorer::worst_reverse_px`]).
+    pub fn worst_reverse_px(&mut self, scene: &Scene<'_>, q: &[f32; MAX_STATES]) -> Option<f32> {
+        let config = self.config.likelihood;
+        self.scratch
+            .worst_reverse_px(scene, &q[..self.n_states], &config)
     }
 
     /// [`Self::score_cameras`] under another likelihood `config` (whose edge maps `scene`

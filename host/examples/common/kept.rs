@@ -106,6 +106,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "rev" => o.hypotheses.likelihood.reverse_weight = f,
             "arev" => o.acquire.likelihood.reverse_weight = f,
             "wrev" => o.watch.reverse_weight = f,
+            "wrx" => o.watch.max_reverse_px = f,
             "accm" => {
                 o.finder.accept.min_score = f;
                 o.finder.accept.min_camera_score = f;
