@@ -47,6 +47,10 @@ pub struct WatchConfig {
     /// edges near the hand to the nearest line of it that could explain them);
     /// `f32::INFINITY`, the default, asks nothing of it and computes nothing.
     pub max_reverse_px: f32,
+    /// The reverse term's bar applies only to a check whose worst camera scores at least this
+    /// much (likelihood units) under the track's reference: a weaker drop than
+    /// [`Self::max_drop`], confirmed by the edges left unexplained. 0: whatever the score.
+    pub reverse_min_drop: f32,
 }
 
 impl Default for WatchConfig {
@@ -56,6 +60,7 @@ impl Default for WatchConfig {
             max_drop: 0.10,
             reverse_weight: 0.0,
             max_reverse_px: f32::INFINITY,
+            reverse_min_drop: 0.0,
         }
     }
 }
@@ -125,7 +130,13 @@ impl Watch {
     /// score becomes its reference and passes, unless its reverse term is over the bar.
     pub fn judge(&mut self, worst_camera_score: f32, reverse_px: Option<f32>) -> bool {
         self.since_check = 0;
-        let explains_its_edges = reverse_px.is_none_or(|px| px <= self.config.max_reverse_px);
+        let min_drop = self.config.reverse_min_drop;
+        let dropped = min_drop <= 0.0
+            || self
+                .reference
+                .is_some_and(|reference| worst_camera_score < reference - min_drop);
+        let explains_its_edges =
+            !dropped || reverse_px.is_none_or(|px| px <= self.config.max_reverse_px);
         let scored = worst_camera_score.is_finite()
             && match self.reference {
                 None => {
@@ -262,5 +273,38 @@ mod tests {
             "the score still counts"
         );
         assert_eq!(barred.reference(), Some(0.95));
+    }
+
+    #[test]
+    fn with_a_minimum_drop_the_reverse_bar_only_confirms_a_falling_score() {
+        let mut w = Watch::new(
+            WatchConfig {
+                every_frames: 1,
+                max_reverse_px: 4.0,
+                reverse_min_drop: 0.03,
+                ..WatchConfig::default()
+            },
+            WATCH_REFERENCE_PIXELS,
+        );
+        assert!(
+            w.due() && w.judge(0.95, Some(9.0)),
+            "no reference yet: no drop"
+        );
+        assert!(
+            w.due() && w.judge(0.94, Some(9.0)),
+            "0.01 under: the edges not asked"
+        );
+        assert!(
+            w.due() && !w.judge(0.90, Some(4.5)),
+            "0.05 under and over the bar"
+        );
+        assert!(
+            w.due() && w.judge(0.90, Some(3.5)),
+            "0.05 under, within the bar"
+        );
+        assert!(
+            w.due() && !w.judge(0.80, Some(1.0)),
+            "the score's own bar still counts"
+        );
     }
 }

@@ -107,6 +107,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "arev" => o.acquire.likelihood.reverse_weight = f,
             "wrev" => o.watch.reverse_weight = f,
             "wrx" => o.watch.max_reverse_px = f,
+            "wrd" => o.watch.reverse_min_drop = f,
             "accm" => {
                 o.finder.accept.min_score = f;
                 o.finder.accept.min_camera_score = f;
