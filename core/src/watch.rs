@@ -19,6 +19,10 @@
 //! the 2,411 right ones; 0.08 flagged 326 and 8.
 //!
 //! While a check fails the track is *in doubt*: every frame is checked until one passes.
+//!
+//! A check can also ask how much of the image's edges near the hand the state leaves
+//! unexplained (the reverse chamfer term, [`WatchConfig::max_reverse_px`]); off by default:
+//! it flagged right tracks too (docs/robustness.md, "The reverse term as a bar of the watch").
 
 /// The frame size (px) at which a check falls due every [`WatchConfig::every_frames`]
 /// frames: 320×240.

@@ -1,4 +1,5 @@
-//! Whether a refined leaf is the hand: its likelihood against thresholds set from measured
+//! Whether a refined leaf is the hand: its likelihood (and, with one camera, how much of
+//! the image's edges near it it leaves unexplained) against thresholds set from measured
 //! distributions (docs/recovery.md): the refined leaf's score on frames with the hand where
 //! it is right, where it is wrong, and on frames with no hand (plain, noisy, cluttered).
 
@@ -23,7 +24,7 @@ pub struct AcceptConfig {
     /// The same with one camera (px; `f32::INFINITY`: not asked). A single view's wrong
     /// leaves pass its score bar far more often than two views' do; right leaves leave a
     /// median 2.8 px, wrong ones 3.8 px, and 3.5 px keeps nine right leaves in ten
-    /// (docs/recovery.md, "A bar on the reverse term").
+    /// (docs/recovery.md, "A bar on the reverse term itself").
     pub one_camera_max_reverse_px: f32,
 }
 
