@@ -160,7 +160,7 @@ impl StateScorer {
         (mean_score(&each[..n]), worst)
     }
 
-    /// The largest [reverse chamfer term](super::reverse) of `q` over the cameras (px,
+    /// The largest [reverse chamfer term](super) of `q` over the cameras (px,
     /// 0..=`reverse_cap_px`), whatever `config`'s `reverse_weight`: how far the worst view's
     /// edges near the hand lie from the lines that would explain them. `None` when `q` cannot
     /// be posed or no camera has an edge near the projected hand.
