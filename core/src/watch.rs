@@ -244,19 +244,25 @@ mod tests {
         assert!((0..100).all(|_| !w.due()));
     }
 
+    /// A watch checking every frame with a bar on the reverse term.
+    fn reverse_barred(max_reverse_px: f32, reverse_min_drop: f32) -> Watch {
+        Watch::new(
+            WatchConfig {
+                every_frames: 1,
+                max_reverse_px,
+                reverse_min_drop,
+                ..WatchConfig::default()
+            },
+            WATCH_REFERENCE_PIXELS,
+        )
+    }
+
     #[test]
     fn edges_left_unexplained_fail_a_check_only_under_a_finite_bar() {
         let mut plain = every(1);
         assert!(!plain.weighs_reverse());
         assert!(plain.due() && plain.judge(0.95, Some(9.0)));
-        let mut barred = Watch::new(
-            WatchConfig {
-                every_frames: 1,
-                max_reverse_px: 4.0,
-                ..WatchConfig::default()
-            },
-            WATCH_REFERENCE_PIXELS,
-        );
+        let mut barred = reverse_barred(4.0, 0.0);
         assert!(barred.weighs_reverse());
         assert!(barred.due() && barred.judge(0.95, Some(3.0)));
         assert!(
@@ -281,15 +287,7 @@ mod tests {
 
     #[test]
     fn with_a_minimum_drop_the_reverse_bar_only_confirms_a_falling_score() {
-        let mut w = Watch::new(
-            WatchConfig {
-                every_frames: 1,
-                max_reverse_px: 4.0,
-                reverse_min_drop: 0.03,
-                ..WatchConfig::default()
-            },
-            WATCH_REFERENCE_PIXELS,
-        );
+        let mut w = reverse_barred(4.0, 0.03);
         assert!(
             w.due() && w.judge(0.95, Some(9.0)),
             "no reference yet: no drop"
