@@ -288,25 +288,15 @@ mod tests {
     #[test]
     fn with_a_minimum_drop_the_reverse_bar_only_confirms_a_falling_score() {
         let mut w = reverse_barred(4.0, 0.03);
-        assert!(
-            w.due() && w.judge(0.95, Some(9.0)),
-            "no reference yet: no drop"
-        );
-        assert!(
-            w.due() && w.judge(0.94, Some(9.0)),
-            "0.01 under: the edges not asked"
-        );
-        assert!(
-            w.due() && !w.judge(0.90, Some(4.5)),
-            "0.05 under and over the bar"
-        );
-        assert!(
-            w.due() && w.judge(0.90, Some(3.5)),
-            "0.05 under, within the bar"
-        );
-        assert!(
-            w.due() && !w.judge(0.80, Some(1.0)),
-            "the score's own bar still counts"
-        );
+        for (score, reverse_px, passes, why) in [
+            (0.95, 9.0, true, "no reference yet: no drop"),
+            (0.94, 9.0, true, "0.01 under: the edges not asked"),
+            (0.90, 4.5, false, "0.05 under and over the bar"),
+            (0.90, 3.5, true, "0.05 under, within the bar"),
+            (0.80, 1.0, false, "the score's own bar still counts"),
+        ] {
+            assert!(w.due());
+            assert_eq!(w.judge(score, Some(reverse_px)), passes, "{why}");
+        }
     }
 }
