@@ -17,9 +17,7 @@ use common::search::{self, acquire_mono, WITHIN_FRAMES};
 /// under it neither arm acquires seed 10224, so the pursuit is shown where it was
 /// measured.
 fn unbarred() -> FinderConfig {
-    let mut config = FinderConfig::default();
-    config.accept.one_camera_max_reverse_px = f32::INFINITY;
-    config
+    search::without_reverse_bar(FinderConfig::default())
 }
 
 /// The same with no leaf pursued.

@@ -17,13 +17,11 @@ use common::search::{self, acquire_mono, WITHIN_FRAMES};
 /// 4.4 and 4.1 px of their frames' edges unexplained, over its 3.5 px, and are refused in
 /// both arms.
 fn settling(settle_frames: u8) -> FinderConfig {
-    let mut config = FinderConfig {
+    search::without_reverse_bar(FinderConfig {
         settle_frames,
         confirm_depth_share: [0.0, 0.0],
         ..FinderConfig::default()
-    };
-    config.accept.one_camera_max_reverse_px = f32::INFINITY;
-    config
+    })
 }
 
 #[test]

@@ -125,6 +125,14 @@ pub struct MonoRun {
     pub most_hypotheses: usize,
 }
 
+/// `finder` without one camera's bar on the reverse chamfer term (`AcceptConfig::
+/// one_camera_max_reverse_px`, on by default since stop 53), for the tests that show another
+/// mechanism on a seed whose acceptance that bar refuses, in both their arms.
+pub fn without_reverse_bar(mut finder: FinderConfig) -> FinderConfig {
+    finder.accept.one_camera_max_reverse_px = f32::INFINITY;
+    finder
+}
+
 /// `random-mono` `seed` acquired from nothing under the search's `finder`, as
 /// `acquire_probe --limit-px 20` counts it. Every frame also checks that the tracker's own
 /// configuration is `TrackerConfig::default()`, whatever the status machine does to it
