@@ -4,6 +4,7 @@
 //! x right, y down), then to pixels `u = fx · x_c / z_c + cx`, `v = fy · y_c / z_c + cy`.
 //! Pixel (0, 0) is the centre of the top-left pixel.
 
+use crate::float::Length;
 use core::fmt;
 
 use nalgebra::{Matrix2x3, Matrix3, Vector2, Vector3};
@@ -72,8 +73,8 @@ impl Camera {
         (width, height): (u32, u32),
         focal_px: f32,
     ) -> Option<Camera> {
-        let forward = forward.try_normalize(f32::EPSILON)?;
-        let right = forward.cross(&up).try_normalize(f32::EPSILON)?;
+        let forward = forward.try_normalized(f32::EPSILON)?;
+        let right = forward.cross(&up).try_normalized(f32::EPSILON)?;
         let down = forward.cross(&right);
         let r = Matrix3::from_rows(&[right.transpose(), down.transpose(), forward.transpose()]);
         let camera = Camera {

@@ -121,7 +121,7 @@ impl FeatureConfig {
     /// `tan(max_edge_angle_rad)`, or `None` when every edge is kept.
     pub fn edge_tangent_limit(&self) -> Option<f32> {
         (self.max_edge_angle_rad < core::f32::consts::FRAC_PI_2 - 1e-3)
-            .then(|| libm::tanf(self.max_edge_angle_rad.max(0.0)))
+            .then(|| crate::float::tan(self.max_edge_angle_rad.max(0.0)))
     }
 }
 

@@ -25,6 +25,7 @@
 //! while inside ([`region_row`](crate::estimator::region_row)). No allocation: the samples
 //! live in a caller-owned [`FillPoints`] of fixed capacity.
 
+use crate::float::Length;
 use heapless::Vec;
 use nalgebra::Vector2;
 
@@ -116,7 +117,7 @@ impl FillConfig {
     pub fn link_weight(&self, link: &ProjectedLink) -> f32 {
         let widths = self.full_length_widths * link.mean_width_px();
         if widths > 0.0 {
-            self.weight * ((link.b - link.a).norm() / widths).min(1.0)
+            self.weight * ((link.b - link.a).length() / widths).min(1.0)
         } else {
             self.weight
         }

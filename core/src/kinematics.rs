@@ -51,12 +51,12 @@ impl Pose {
 
     /// The DH transform `Rot_z(theta) · Trans_z(d) · Trans_x(a) · Rot_x(alpha)`.
     pub fn dh(theta: f32, d: f32, a: f32, alpha: f32) -> Pose {
-        Pose::dh_twisted(theta, d, a, libm::sincosf(alpha))
+        Pose::dh_twisted(theta, d, a, crate::float::sin_cos(alpha))
     }
 
     /// [`Pose::dh`] with the twist given by its sine and cosine.
     pub fn dh_twisted(theta: f32, d: f32, a: f32, (sa, ca): (f32, f32)) -> Pose {
-        let (s, c) = libm::sincosf(theta);
+        let (s, c) = crate::float::sin_cos(theta);
         Pose {
             r: Matrix3::new(c, -s * ca, s * sa, s, c * ca, -c * sa, 0.0, sa, ca),
             t: Vector3::new(a * c, a * s, d),

@@ -45,6 +45,7 @@ pub mod config;
 pub mod estimator;
 pub mod features;
 pub mod fill;
+pub mod float;
 pub mod frame;
 pub mod hypotheses;
 pub mod kinematics;

@@ -512,7 +512,7 @@ fn parse_row<'a>(
             parent: None,
             children: Vec::new(),
             line,
-            alpha_sin_cos: libm::sincosf(alpha),
+            alpha_sin_cos: crate::float::sin_cos(alpha),
         },
         children,
     })

@@ -7,6 +7,7 @@
 //! row's derivative comes from the two corners' derivatives (7 palm states) through the
 //! camera.
 
+use crate::float::Length;
 use heapless::Vec;
 use nalgebra::Vector2;
 
@@ -77,7 +78,7 @@ impl PalmOutline {
             let c1 = hull[(i + 1) % n];
             let (i0, i1) = (usize::from(c0), usize::from(c1));
             let (a, b) = (palm.corners_px[i0], palm.corners_px[i1]);
-            if (b - a).norm() < min_edge_px {
+            if (b - a).length() < min_edge_px {
                 continue;
             }
             let segment = ProjectedLink {
@@ -153,7 +154,7 @@ pub fn convex_hull(points: &[Vector2<f32>; BOX_CORNERS], out: &mut [u8; BOX_CORN
             points[usize::from(next)],
         );
         let (u, v) = (a - o, b - a);
-        let scale = u.norm() * v.norm();
+        let scale = u.length() * v.length();
         scale > 0.0 && u.x * v.y - u.y * v.x > MIN_HULL_TURN * scale
     };
     for &k in order.iter() {

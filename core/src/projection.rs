@@ -1,6 +1,7 @@
 //! The model seen by one camera: every capsule link's axis and radius in the image, and the
 //! palm, with depths for visibility reasoning.
 
+use crate::float::Length;
 use heapless::Vec;
 use nalgebra::{Matrix3, Vector2, Vector3};
 
@@ -14,7 +15,7 @@ use crate::model::{Model, Shape};
 #[inline]
 pub fn axis_frame(a: &Vector2<f32>, b: &Vector2<f32>) -> (Vector2<f32>, Vector2<f32>) {
     let d = b - a;
-    let len = d.norm();
+    let len = d.length();
     let dir = if len > 1e-6 {
         d / len
     } else {
@@ -116,7 +117,7 @@ impl ProjectedLink {
 
     /// Image length of the axis (px).
     pub fn length(&self) -> f32 {
-        (self.b - self.a).norm()
+        (self.b - self.a).length()
     }
 
     /// Closest axis parameter `s ∈ [0, 1]` to image point `p`, and the distance (px).
@@ -128,7 +129,7 @@ impl ProjectedLink {
         } else {
             0.0
         };
-        (s, (self.a + d * s - p).norm())
+        (s, (self.a + d * s - p).length())
     }
 
     /// Mean projected radius at axis parameter `s` (px).
@@ -274,7 +275,7 @@ impl ProjectedModel {
                         self.skipped.off_frame += 1;
                         continue;
                     }
-                    if (b - a).norm() < min_length_px {
+                    if (b - a).length() < min_length_px {
                         self.skipped.end_on += 1;
                         continue;
                     }
@@ -422,7 +423,7 @@ fn knuckle_ends(
     };
     let onward = end - b;
     let turns_back = onward.dot(&(b - a)) < 0.0;
-    let short_and_away = onward.norm() < end_radius_px && camera.to_camera(&far).z > depth_b;
+    let short_and_away = onward.length() < end_radius_px && camera.to_camera(&far).z > depth_b;
     turns_back || short_and_away
 }
 
@@ -447,19 +448,19 @@ fn silhouette_offsets(
         fallback(camera.to_camera(p1).z),
     );
     let axis = p1 - p0;
-    let Some(d) = axis.try_normalize(1e-6) else {
+    let Some(d) = axis.try_normalized(1e-6) else {
         return approx;
     };
     let rel = p0 - camera.centre();
     let w = rel - d * rel.dot(&d);
-    let dist = w.norm();
+    let dist = w.length();
     if dist <= radius * 1.001 {
         return approx;
     }
     let w = w / dist;
     let m = d.cross(&w);
     let sin = radius / dist;
-    let cos = libm::sqrtf(1.0 - sin * sin);
+    let cos = crate::float::sqrt(1.0 - sin * sin);
     let (_, normal) = axis_frame(a, b);
     let mut out = approx;
     for sign in [1.0f32, -1.0] {
@@ -495,24 +496,24 @@ fn sphere_outline_offset(
     let z = camera.to_camera(c).z;
     let approx = camera.pixels_at_depth(radius, z);
     let d = b - a;
-    let len = d.norm();
+    let len = d.length();
     if len < 1e-6 {
         return approx;
     }
     let dir = d / len;
-    let ray = |p: Vector2<f32>| camera.ray(&p).normalize();
+    let ray = |p: Vector2<f32>| camera.ray(&p).normalized();
     let to_centre = camera.to_camera(c);
-    let dist = to_centre.norm();
+    let dist = to_centre.length();
     if dist <= radius * 1.001 {
         return approx;
     }
     let rc = to_centre / dist;
     let beside = ray(b + dir * 10.0);
-    let Some(t) = (beside - rc * beside.dot(&rc)).try_normalize(1e-9) else {
+    let Some(t) = (beside - rc * beside.dot(&rc)).try_normalized(1e-9) else {
         return approx;
     };
     let sin = radius / dist;
-    let cos = libm::sqrtf(1.0 - sin * sin);
+    let cos = crate::float::sqrt(1.0 - sin * sin);
     let tangent = rc * cos + t * sin;
     if tangent.z < 1e-6 {
         return approx;

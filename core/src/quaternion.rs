@@ -1,5 +1,6 @@
 //! Unit quaternions `(w, x, y, z)` as used by the palm's spatial transform (states q0..q3).
 
+use crate::float::Length;
 use nalgebra::{Matrix3, Vector3};
 
 /// Rotation matrix of the unit quaternion `(w, x, y, z)`; the caller normalises.
@@ -19,7 +20,7 @@ pub fn rotation(w: f32, x: f32, y: f32, z: f32) -> Matrix3<f32> {
 
 /// Euclidean norm of a 4-vector.
 pub fn norm4(q: [f32; 4]) -> f32 {
-    libm::sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    crate::float::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
 }
 
 /// `q / |q|`, or `None` when `q` is zero or not finite.
@@ -70,14 +71,14 @@ pub fn angle_between(a: [f32; 4], b: [f32; 4]) -> f32 {
     let (bw, bv) = (b[0], Vector3::new(b[1], b[2], b[3]));
     let w = aw * bw + av.dot(&bv);
     let v = bv * aw - av * bw - av.cross(&bv);
-    2.0 * libm::atan2f(v.norm(), w.abs())
+    2.0 * libm::atan2f(v.length(), w.abs())
 }
 
 /// The unit quaternion `(w, x, y, z)` of a rotation matrix (Shepperd's method).
 pub fn from_rotation(m: &Matrix3<f32>) -> [f32; 4] {
     let tr = m[(0, 0)] + m[(1, 1)] + m[(2, 2)];
     let q = if tr > 0.0 {
-        let s = libm::sqrtf(tr + 1.0) * 2.0;
+        let s = crate::float::sqrt(tr + 1.0) * 2.0;
         [
             0.25 * s,
             (m[(2, 1)] - m[(1, 2)]) / s,
@@ -85,7 +86,7 @@ pub fn from_rotation(m: &Matrix3<f32>) -> [f32; 4] {
             (m[(1, 0)] - m[(0, 1)]) / s,
         ]
     } else if m[(0, 0)] > m[(1, 1)] && m[(0, 0)] > m[(2, 2)] {
-        let s = libm::sqrtf(1.0 + m[(0, 0)] - m[(1, 1)] - m[(2, 2)]) * 2.0;
+        let s = crate::float::sqrt(1.0 + m[(0, 0)] - m[(1, 1)] - m[(2, 2)]) * 2.0;
         [
             (m[(2, 1)] - m[(1, 2)]) / s,
             0.25 * s,
@@ -93,7 +94,7 @@ pub fn from_rotation(m: &Matrix3<f32>) -> [f32; 4] {
             (m[(0, 2)] + m[(2, 0)]) / s,
         ]
     } else if m[(1, 1)] > m[(2, 2)] {
-        let s = libm::sqrtf(1.0 + m[(1, 1)] - m[(0, 0)] - m[(2, 2)]) * 2.0;
+        let s = crate::float::sqrt(1.0 + m[(1, 1)] - m[(0, 0)] - m[(2, 2)]) * 2.0;
         [
             (m[(0, 2)] - m[(2, 0)]) / s,
             (m[(0, 1)] + m[(1, 0)]) / s,
@@ -101,7 +102,7 @@ pub fn from_rotation(m: &Matrix3<f32>) -> [f32; 4] {
             (m[(1, 2)] + m[(2, 1)]) / s,
         ]
     } else {
-        let s = libm::sqrtf(1.0 + m[(2, 2)] - m[(0, 0)] - m[(1, 1)]) * 2.0;
+        let s = crate::float::sqrt(1.0 + m[(2, 2)] - m[(0, 0)] - m[(1, 1)]) * 2.0;
         [
             (m[(1, 0)] - m[(0, 1)]) / s,
             (m[(0, 2)] + m[(2, 0)]) / s,

@@ -13,6 +13,7 @@
 
 use crate::camera::Camera;
 use crate::config::MAX_STATES;
+use crate::float::Length;
 use crate::likelihood::{Region, StateScorer};
 use crate::model::Model;
 use crate::nalgebra::{Vector2, Vector3};
@@ -48,7 +49,7 @@ impl StateScorer {
         }
         let b = hand_bounds(&self.view)?;
         let size = b.max - b.min;
-        Some(((b.min + b.max) / 2.0, size.norm()))
+        Some(((b.min + b.max) / 2.0, size.length()))
     }
 }
 
@@ -143,7 +144,7 @@ pub(crate) fn place(
         }
     }
     // One camera: the depth from the size (image size falls as 1/depth), then the centre.
-    let size_o = r0.size_px().norm();
+    let size_o = r0.size_px().length();
     let z1 = match depth {
         Depth::FromRegion if size_o > 1.0 && diag0 > 1.0 => {
             (z0 * diag0 / size_o).clamp(z_near, z_far)

@@ -2,7 +2,10 @@
 
 /// Quaternion (w, x, y, z) of a turn of `angle` rad about unit `axis`.
 pub(crate) fn axis_angle(axis: [f32; 3], angle: f32) -> [f32; 4] {
-    let (s, c) = (libm::sinf(angle / 2.0), libm::cosf(angle / 2.0));
+    let (s, c) = (
+        crate::float::sin(angle / 2.0),
+        crate::float::cos(angle / 2.0),
+    );
     [c, axis[0] * s, axis[1] * s, axis[2] * s]
 }
 
@@ -23,12 +26,12 @@ pub(crate) fn compose(a: &[f32; 4], b: &[f32; 4]) -> [f32; 4] {
 pub(crate) fn coarse_rotation(k: u32, normals: u32, j: u32, spins: u32) -> [f32; 4] {
     const GOLDEN_ANGLE: f32 = 2.399_963;
     let z = 1.0 - 2.0 * (k as f32 + 0.5) / normals as f32;
-    let r = libm::sqrtf((1.0 - z * z).max(0.0));
+    let r = crate::float::sqrt((1.0 - z * z).max(0.0));
     let phi = k as f32 * GOLDEN_ANGLE;
-    let n = [r * libm::cosf(phi), r * libm::sinf(phi), z];
+    let n = [r * crate::float::cos(phi), r * crate::float::sin(phi), z];
     // Turn e_z onto n: about e_z × n by acos(n_z).
     let axis = [-n[1], n[0], 0.0];
-    let len = libm::sqrtf(axis[0] * axis[0] + axis[1] * axis[1]);
+    let len = crate::float::sqrt(axis[0] * axis[0] + axis[1] * axis[1]);
     let align = if len < 1e-6 {
         if z > 0.0 {
             [1.0, 0.0, 0.0, 0.0]
@@ -59,7 +62,7 @@ mod tests {
             .flat_map(|k| (0..6).map(move |j| coarse_rotation(k, 20, j, 6)))
             .collect();
         for q in &all {
-            let n = libm::sqrtf(q.iter().map(|v| v * v).sum::<f32>());
+            let n = crate::float::sqrt(q.iter().map(|v| v * v).sum::<f32>());
             assert!((n - 1.0).abs() < 1e-5);
         }
         // Every rotation of a fine random set lies within 50° of some coarse one.
@@ -67,11 +70,11 @@ mod tests {
         for i in 0..500 {
             let t = i as f32 * 0.618_034;
             let axis = [
-                libm::cosf(t * 7.0),
-                libm::sinf(t * 7.0),
-                libm::cosf(t * 3.0),
+                crate::float::cos(t * 7.0),
+                crate::float::sin(t * 7.0),
+                crate::float::cos(t * 3.0),
             ];
-            let len = libm::sqrtf(axis.iter().map(|v| v * v).sum::<f32>());
+            let len = crate::float::sqrt(axis.iter().map(|v| v * v).sum::<f32>());
             let r = axis_angle(axis.map(|v| v / len), (t * 13.0) % core::f32::consts::PI);
             let nearest = all
                 .iter()

@@ -149,7 +149,7 @@ impl NormalEquations {
         if self.rows == 0 {
             0.0
         } else {
-            libm::sqrtf(self.sum_squares / f32::from(self.rows))
+            crate::float::sqrt(self.sum_squares / f32::from(self.rows))
         }
     }
 

@@ -62,7 +62,7 @@ fn total_least_squares(
     }
     // Direction of largest spread: angle of the principal axis of the 2×2 scatter matrix.
     let angle = 0.5 * libm::atan2f(2.0 * sxy, sxx - syy);
-    let (s, c) = libm::sincosf(angle);
+    let (s, c) = crate::float::sin_cos(angle);
     if sxx + syy < 1e-6 {
         return None;
     }

@@ -12,6 +12,7 @@
 //! The angles are found by a grid over each joint's range (the jump is a discrete choice;
 //! Gauss–Newton refines the result on the frame).
 
+use crate::float::Length;
 use heapless::Vec;
 use nalgebra::Vector3;
 
@@ -171,7 +172,7 @@ fn jump_at(
         // The first point beyond frame i's origin: what turning joint i moves.
         let origin = world[i].t;
         let Some(target_index) =
-            (i + 1..chain.frames.len()).find(|&k| (before[k].t - origin).norm() > SAME_POINT_MM)
+            (i + 1..chain.frames.len()).find(|&k| (before[k].t - origin).length() > SAME_POINT_MM)
         else {
             // A pivot that moves no point cannot jump; a later joint that moves none keeps
             // its angle.
@@ -210,7 +211,7 @@ fn jump_at(
     let mut moved_count = 0u32;
     let mut moved_mm = 0.0f32;
     for (after, was) in world.iter().zip(&before).skip(pivot_index + 1) {
-        moved_mm += (after.t - was.t).norm();
+        moved_mm += (after.t - was.t).length();
         if let Some(d) = image_distance(cameras, &after.t, &was.t) {
             moved_sum += d;
             moved_count += 1;
@@ -252,7 +253,7 @@ fn image_distance(cameras: &[Camera], a: &Vector3<f32>, b: &Vector3<f32>) -> Opt
     let mut count = 0u32;
     for camera in cameras {
         if let (Some(pa), Some(pb)) = (camera.project(a), camera.project(b)) {
-            sum += (pa - pb).norm();
+            sum += (pa - pb).length();
             count += 1;
         }
     }
@@ -303,7 +304,7 @@ mod tests {
             .unwrap()
             .origin(PIP_FRAME)
             .unwrap();
-        let along = (pa - pb).normalize();
+        let along = (pa - pb).normalized();
         let eye = pa + along * distance_mm;
         let up = if along.z.abs() < 0.9 {
             Vector3::z()
@@ -353,7 +354,7 @@ mod tests {
             .origin(PIP_FRAME)
             .unwrap();
         let after = Poses::compute(&model, &jump.state[..28]).unwrap();
-        assert!((after.origin(PIP_FRAME).unwrap() - before).norm() > 15.0);
+        assert!((after.origin(PIP_FRAME).unwrap() - before).length() > 15.0);
         // Only the middle finger's joints moved.
         for (s, (after, was)) in jump.state.iter().zip(&q).enumerate() {
             if !(MCP..=MCP + 2).contains(&s) {

@@ -201,7 +201,7 @@ mod tests {
         assert_eq!(weak.len(), 2);
         let d = weak[0].direction;
         // Along q8 − q9, in spread units of length 1; nothing on the seen states.
-        let unit = spread.joint_rad / libm::sqrtf(2.0);
+        let unit = spread.joint_rad / crate::float::sqrt(2.0);
         assert!((libm::fabsf(d[8]) - unit).abs() < 1e-4, "{d:?}");
         assert!((d[8] + d[9]).abs() < 1e-4, "{d:?}");
         assert!(d[7].abs() < 1e-4 && d[10].abs() < 1e-4, "{d:?}");

@@ -13,6 +13,7 @@
 //! At most [`MAX_REVERSE_CELLS`] cells are visited: a larger region is visited on a coarser
 //! lattice of cells, so the cost per view is bounded whatever the hand's size in the image.
 
+use crate::float::Length;
 use heapless::Vec;
 
 use crate::config::MAX_LINKS;
@@ -63,7 +64,7 @@ impl Line {
     fn distance_px(&self, p: &Vector2<f32>) -> f32 {
         let d = self.b - self.a;
         let t = ((p - self.a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
-        (self.a + d * t - p).norm()
+        (self.a + d * t - p).length()
     }
 }
 

@@ -1,6 +1,7 @@
 //! The visible silhouette points of a projected hand: what the chamfer term compares with
 //! the frame's edges.
 
+use crate::float::Length;
 use heapless::Vec;
 
 use crate::camera::Camera;
@@ -124,7 +125,7 @@ pub fn visit(
     let n = usize::from(config.samples_per_line).clamp(1, MAX_SAMPLES_PER_LINE);
     for (index, link) in view.links.iter().enumerate() {
         let d = link.b - link.a;
-        let len = d.norm();
+        let len = d.length();
         if len < 1e-3 {
             continue;
         }
