@@ -241,6 +241,22 @@ fn the_bounded_score_is_the_score_or_proves_it_is_under_the_bar() {
         for p in scored_states(&q) {
             let scene = Scene::new(&sequence.model, cameras, &frames, &edges);
             let score = scorer.score(&scene, &p, &config);
+            // A judged leaf's score and reverse term, posed once, are the two computed apart,
+            // whether the likelihood weighs the term or not.
+            for weight in [0.0, 0.8] {
+                let weighed = LikelihoodConfig {
+                    reverse_weight: weight,
+                    ..config
+                };
+                let (mean, worst) = scorer.score_cameras(&scene, &p, &weighed);
+                let reverse = scorer.worst_reverse_px(&scene, &p, &weighed);
+                let (m, w, r) = scorer.score_cameras_and_reverse(&scene, &p, &weighed);
+                assert_eq!(
+                    (m.to_bits(), w.to_bits(), r.map(f32::to_bits)),
+                    (mean.to_bits(), worst.to_bits(), reverse.map(f32::to_bits)),
+                    "{scenario} {seed}, reverse weight {weight}"
+                );
+            }
             for bar in [
                 f32::NEG_INFINITY,
                 score - 0.05,

@@ -549,11 +549,13 @@ impl Acquirer {
         q: &[f32; MAX_STATES],
         accept: &AcceptConfig,
     ) -> LeafScore {
-        let (score, worst_camera) = self.score_cameras(scene, q);
-        let reverse_px = if accept.weighs_reverse(scene.cameras.len()) {
-            self.worst_reverse_px(scene, q)
+        let config = self.config.likelihood;
+        let (score, worst_camera, reverse_px) = if accept.weighs_reverse(scene.cameras.len()) {
+            self.scratch
+                .score_cameras_and_reverse(scene, &q[..self.n_states], &config)
         } else {
-            None
+            let (score, worst) = self.score_cameras_under(scene, q, &config);
+            (score, worst, None)
         };
         LeafScore {
             score,

@@ -66,6 +66,19 @@ impl StateScorer {
         config: &LikelihoodConfig,
         out: &mut [Likelihood; MAX_CAMERAS],
     ) -> usize {
+        self.likelihoods_and_reverse(scene, q, config, out, None)
+    }
+
+    /// [`Self::likelihoods`], and with `worst_reverse` also [`Self::worst_reverse_px`] from
+    /// the same poses and projections.
+    fn likelihoods_and_reverse(
+        &mut self,
+        scene: &Scene<'_>,
+        q: &[f32],
+        config: &LikelihoodConfig,
+        out: &mut [Likelihood; MAX_CAMERAS],
+        mut worst_reverse: Option<&mut Option<f32>>,
+    ) -> usize {
         if !self.pose(scene.model, q) {
             return 0;
         }
@@ -81,6 +94,15 @@ impl StateScorer {
                 return 0;
             }
             *slot = evaluate(&self.view, camera, frame, edges, config);
+            if let Some(worst) = worst_reverse.as_deref_mut() {
+                // `evaluate` computed the term only when it weighs it and saw the hand.
+                let px = slot
+                    .reverse_px
+                    .or_else(|| reverse::reverse_px(&self.view, edges, config));
+                if let Some(px) = px {
+                    *worst = Some(worst.map_or(px, |w| w.max(px)));
+                }
+            }
             n += 1;
         }
         n
@@ -150,14 +172,27 @@ impl StateScorer {
     ) -> (f32, f32) {
         let mut each = [Likelihood::default(); MAX_CAMERAS];
         let n = self.likelihoods(scene, q, config, &mut each);
+        mean_and_worst(&each[..n])
+    }
+
+    /// [`Self::score_cameras`] and [`Self::worst_reverse_px`] together, `q` posed and
+    /// projected once: the mean and worst camera's score, and the worst reverse term (`None`
+    /// when `q` cannot be posed or no camera has an edge near the hand).
+    pub fn score_cameras_and_reverse(
+        &mut self,
+        scene: &Scene<'_>,
+        q: &[f32],
+        config: &LikelihoodConfig,
+    ) -> (f32, f32, Option<f32>) {
+        let mut each = [Likelihood::default(); MAX_CAMERAS];
+        let mut worst_reverse = None;
+        let n = self.likelihoods_and_reverse(scene, q, config, &mut each, Some(&mut worst_reverse));
         if n == 0 {
-            return (0.0, 0.0);
+            // A camera that could not be projected ends the scoring; so it ends the term.
+            worst_reverse = None;
         }
-        let worst = each[..n]
-            .iter()
-            .map(|l| l.score)
-            .fold(f32::INFINITY, f32::min);
-        (mean_score(&each[..n]), worst)
+        let (mean, worst) = mean_and_worst(&each[..n]);
+        (mean, worst, worst_reverse)
     }
 
     /// The largest [reverse chamfer term](super) of `q` over the cameras (px,
@@ -202,6 +237,15 @@ pub struct BoundedScore {
     pub edge_terms: u8,
     /// Cameras whose silhouette term was computed.
     pub silhouette_terms: u8,
+}
+
+/// The mean and the smallest score of `each` (both 0 for none).
+fn mean_and_worst(each: &[Likelihood]) -> (f32, f32) {
+    if each.is_empty() {
+        return (0.0, 0.0);
+    }
+    let worst = each.iter().map(|l| l.score).fold(f32::INFINITY, f32::min);
+    (mean_score(each), worst)
 }
 
 /// The mean score of `each` (0 for none).
