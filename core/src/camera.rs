@@ -4,10 +4,11 @@
 //! x right, y down), then to pixels `u = fx · x_c / z_c + cx`, `v = fy · y_c / z_c + cy`.
 //! Pixel (0, 0) is the centre of the top-left pixel.
 
-use crate::float::Length;
 use core::fmt;
 
 use nalgebra::{Matrix2x3, Matrix3, Vector2, Vector3};
+
+use crate::float::Length;
 
 /// Points nearer than this to the camera plane (mm) do not project.
 pub const MIN_DEPTH: f32 = 1.0;

@@ -25,11 +25,11 @@
 //! while inside ([`region_row`](crate::estimator::region_row)). No allocation: the samples
 //! live in a caller-owned [`FillPoints`] of fixed capacity.
 
-use crate::float::Length;
 use heapless::Vec;
 use nalgebra::Vector2;
 
 use crate::camera::Camera;
+use crate::float::Length;
 use crate::frame::FrameView;
 use crate::projection::{ProjectedLink, ProjectedModel};
 use crate::silhouette::{hand_bounds, MIN_CLASS_SAMPLES};

@@ -30,6 +30,7 @@
 //! - [`hypotheses`]: several hypotheses through ambiguity, each refined by the loop.
 //! - [`measurement`]: measured axis lines and fingertips at a state, for a stereo host.
 //! - [`protocol`]: the board link's messages and their framing (`docs/protocol.md`).
+//! - [`float`]: square root, sine and cosine that stay in single precision on the board's FPU.
 //!
 //! Units everywhere: millimetres, radians, pixels (pixel (0, 0) is the centre of the top-left
 //! pixel). Numbers are `f32`. Every capacity is a named constant in [`config`]; exceeding one

@@ -7,10 +7,10 @@
 //! row's derivative comes from the two corners' derivatives (7 palm states) through the
 //! camera.
 
-use crate::float::Length;
 use heapless::Vec;
 use nalgebra::Vector2;
 
+use crate::float::Length;
 use crate::projection::{Bounds, ProjectedLink, ProjectedPalm, BOX_CORNERS};
 
 /// Most edges of a box's image outline: a box seen from any point outside it shows 4 or 6.

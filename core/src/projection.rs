@@ -1,12 +1,12 @@
 //! The model seen by one camera: every capsule link's axis and radius in the image, and the
 //! palm, with depths for visibility reasoning.
 
-use crate::float::Length;
 use heapless::Vec;
 use nalgebra::{Matrix3, Vector2, Vector3};
 
 use crate::camera::Camera;
 use crate::config::MAX_LINKS;
+use crate::float::Length;
 use crate::kinematics::Poses;
 use crate::model::{Model, Shape};
 

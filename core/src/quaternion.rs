@@ -1,7 +1,8 @@
 //! Unit quaternions `(w, x, y, z)` as used by the palm's spatial transform (states q0..q3).
 
-use crate::float::Length;
 use nalgebra::{Matrix3, Vector3};
+
+use crate::float::Length;
 
 /// Rotation matrix of the unit quaternion `(w, x, y, z)`; the caller normalises.
 pub fn rotation(w: f32, x: f32, y: f32, z: f32) -> Matrix3<f32> {

@@ -12,13 +12,13 @@
 //! The angles are found by a grid over each joint's range (the jump is a discrete choice;
 //! Gauss–Newton refines the result on the frame).
 
-use crate::float::Length;
 use heapless::Vec;
 use nalgebra::Vector3;
 
 use super::fingers::{Fingers, MAX_FINGERS};
 use crate::camera::Camera;
 use crate::config::{MAX_JUMPS, MAX_LINKS, MAX_STATES};
+use crate::float::Length;
 use crate::kinematics::{row_transform, Pose, Poses};
 use crate::model::{Model, Shape, Theta};
 

@@ -13,10 +13,10 @@
 //! At most [`MAX_REVERSE_CELLS`] cells are visited: a larger region is visited on a coarser
 //! lattice of cells, so the cost per view is bounded whatever the hand's size in the image.
 
-use crate::float::Length;
 use heapless::Vec;
 
 use crate::config::MAX_LINKS;
+use crate::float::Length;
 use crate::nalgebra::Vector2;
 use crate::palm_outline::{PalmOutline, MAX_HULL_EDGES};
 use crate::projection::ProjectedModel;

@@ -1,11 +1,11 @@
 //! The visible silhouette points of a projected hand: what the chamfer term compares with
 //! the frame's edges.
 
-use crate::float::Length;
 use heapless::Vec;
 
 use crate::camera::Camera;
 use crate::config::MAX_LINKS;
+use crate::float::Length;
 use crate::nalgebra::Vector2;
 use crate::projection::ProjectedModel;
 use crate::visibility::{candidates, cover_among, Cover};
