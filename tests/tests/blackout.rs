@@ -355,8 +355,10 @@ fn the_local_reacquisition_tries_the_librarys_finger_poses_under_the_last_good_p
     // While the hand is hidden its fingers move on: started from the last good fingers,
     // Gauss-Newton settles on a wrong finger pose, or on none the acceptance takes. The local
     // re-acquisition also starts from the last good palm under the library's finger pose the
-    // likelihood scores best (`FinderConfig::local_library_pose`). `random-stereo` 1014 is
-    // re-acquired only with it. (A seed that shows the mechanism, not a sweep's verdict:
+    // likelihood scores best (`FinderConfig::local_library_pose`). `random-stereo` 1048 is
+    // re-acquired only with it (1014 until sines and cosines were computed in single
+    // precision, stop 54, which moved its run by rounding; of the even seeds 1012-1050, 1048
+    // is the one re-acquired only with it). (A seed that shows the mechanism, not a sweep's verdict:
     // over fresh seeds 1011-1170, of the 103 tracked up to the blackout, 84 are
     // re-acquired with it and 76 without; docs/recovery.md.) The re-acquisition is judged
     // without the free settling after it (`settle_frames` 0), which brings this seed's other
@@ -370,7 +372,7 @@ fn the_local_reacquisition_tries_the_librarys_finger_poses_under_the_last_good_p
         local_library_pose: false,
         ..with
     };
-    reacquired_only_with(1014, with, without, without_rows(), "the library pose");
+    reacquired_only_with(1048, with, without, without_rows(), "the library pose");
 }
 
 #[test]
@@ -511,8 +513,12 @@ fn two_cameras_polish_the_fingers_of_a_re_acquisition_after_its_confirm_phase() 
 fn the_local_reacquisition_turns_the_last_good_palm_far_enough_to_meet_a_rolled_hand() {
     // While the hand is hidden its palm turns on; the local re-acquisition's variants turn
     // the last good palm about each of its axes (`FinderConfig::local_turn_rad`). At 0.3 rad
-    // `random-stereo` 3214, whose hand came back rolled 40-50 degrees about its finger axis,
-    // was refined into a wrong hand and held; at 0.7 rad (the default) it is re-acquired.
+    // `random-stereo` 3220 takes no start back in the 30 frames after its blackout; at 0.7
+    // rad (the default) it is re-acquired, after ten frames on a wrong hand. (3214, whose
+    // hand came back rolled 40-50 degrees, showed it until sines and cosines were computed
+    // in single precision, stop 54, which moved its run by rounding; of the even seeds
+    // 3202-3330, 3220 is the one re-acquired only at 0.7 rad whose runs agree up to the
+    // blackout.)
     // (A seed that shows the mechanism, not a sweep's verdict: over 583 seeds of 2751-3550,
     // 531 of those tracked to the blackout are re-acquired at 0.7 rad and 522 at 0.3;
     // docs/recovery.md.)
@@ -524,7 +530,7 @@ fn the_local_reacquisition_turns_the_last_good_palm_far_enough_to_meet_a_rolled_
         ..with
     };
     reacquired_only_with(
-        3214,
+        3220,
         with,
         without,
         TrackerConfig::default(),
