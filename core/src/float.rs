@@ -10,9 +10,10 @@
 //!
 //! Here the same functions stay in `f32`:
 //! - [`sin_cos`]: Cody–Waite reduction by π/2 in three parts, then the Cephes single-precision
-//!   polynomials on [−π/4, π/4]. Within 8·10⁻⁸ of the exact values for |x| ≤ [`REDUCED_UP_TO`]
-//!   (about 0.7 ulp of 1; `libm`'s: 3·10⁻⁸), tested against `f64` below. Beyond that, and for
-//!   NaN or infinity, `libm` answers (a NaN stays NaN).
+//!   polynomials on [−π/4, π/4]. Within 8·10⁻⁸ of the exact values for |x| ≤ 100 (about
+//!   0.7 ulp of 1; `libm`'s: 3·10⁻⁸; joint angles lie within ±π), 2·10⁻⁷ up to
+//!   [`REDUCED_UP_TO`], tested against `f64` below. Beyond that, and for NaN or infinity,
+//!   `libm` answers (a NaN stays NaN).
 //! - [`sqrt`]: the FPU's `vsqrt.f32` on an Arm target with a hardware FPU (`eabihf`),
 //!   `libm::sqrtf` elsewhere (on x86-64 already the SSE instruction). Both are correctly
 //!   rounded, so the board and the host still agree bit for bit.
