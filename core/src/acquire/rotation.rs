@@ -2,10 +2,7 @@
 
 /// Quaternion (w, x, y, z) of a turn of `angle` rad about unit `axis`.
 pub(crate) fn axis_angle(axis: [f32; 3], angle: f32) -> [f32; 4] {
-    let (s, c) = (
-        crate::float::sin(angle / 2.0),
-        crate::float::cos(angle / 2.0),
-    );
+    let (s, c) = crate::float::sin_cos(angle / 2.0);
     [c, axis[0] * s, axis[1] * s, axis[2] * s]
 }
 
@@ -28,7 +25,8 @@ pub(crate) fn coarse_rotation(k: u32, normals: u32, j: u32, spins: u32) -> [f32;
     let z = 1.0 - 2.0 * (k as f32 + 0.5) / normals as f32;
     let r = crate::float::sqrt((1.0 - z * z).max(0.0));
     let phi = k as f32 * GOLDEN_ANGLE;
-    let n = [r * crate::float::cos(phi), r * crate::float::sin(phi), z];
+    let (sin_phi, cos_phi) = crate::float::sin_cos(phi);
+    let n = [r * cos_phi, r * sin_phi, z];
     // Turn e_z onto n: about e_z × n by acos(n_z).
     let axis = [-n[1], n[0], 0.0];
     let len = crate::float::sqrt(axis[0] * axis[0] + axis[1] * axis[1]);
