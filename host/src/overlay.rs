@@ -2,9 +2,11 @@
 //! back-projected model at a state, the slices the tracker searches at that state, the edge
 //! points and fingertips the search found (colours: [`colours`], `docs/overlay.md`).
 //!
-//! The search drawn is core's own ([`find_link_features`] over every projected link, as
-//! `core::measurement` runs it), so the overlay shows exactly what the tracker would measure
-//! at `q` with `config`'s full window (the tracker's later iterations of a frame narrow it).
+//! The search drawn is core's own
+//! ([`find_link_features`](digiteyes_core::features::find_link_features) over every projected
+//! link, as `core::measurement` runs it), so the overlay shows exactly what the tracker would
+//! measure at `q` with `config`'s full window (the tracker's later iterations of a frame narrow
+//! it).
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{sync_channel, SyncSender};

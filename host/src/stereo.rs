@@ -4,7 +4,7 @@
 //! answers with what every link and palm outline edge showed (`LinkEdges` …, `PalmEdges` …,
 //! `Measured`), and the host fuses all of
 //! it in one solve — the same tracker loop as `track`, fed through a
-//! [`Measurer`](digiteyes_core::measurer::Measurer) — then sends the new state back.
+//! [`Measurer`] — then sends the new state back.
 //!
 //! ```text
 //! host                                      board (one per camera)

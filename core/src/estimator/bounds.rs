@@ -24,7 +24,7 @@ pub const MAX_BOUND_ROUNDS: usize = 3;
 impl NormalEquations {
     /// The conditioned Gauss–Newton step ([`step`](Self::step)) at state `q`, with every free
     /// joint the step would carry out of its range held at its bound and the other free states
-    /// solved again for it, up to [`MAX_BOUND_ROUNDS`] times. Bit for bit the plain step when
+    /// solved again for it, up to `MAX_BOUND_ROUNDS` times. Bit for bit the plain step when
     /// no bound is crossed. `None` as for [`step`](Self::step), or if `q` is shorter than the
     /// model's states.
     pub fn bounded_step(

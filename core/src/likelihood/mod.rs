@@ -48,8 +48,8 @@ pub struct LikelihoodConfig {
     /// Weight of the silhouette term in [`Likelihood::score`] (0..=1); the chamfer term has
     /// the rest.
     pub silhouette_weight: f32,
-    /// Weight of the [reverse chamfer term](reverse): the score loses this much times the
-    /// term over its cap (0, the default, leaves it out and computes nothing).
+    /// Weight of the reverse chamfer term (`likelihood::reverse`): the score loses this much
+    /// times the term over its cap (0, the default, leaves it out and computes nothing).
     pub reverse_weight: f32,
     /// Reverse distances are truncated here (px).
     pub reverse_cap_px: f32,

@@ -111,8 +111,8 @@ impl StateScorer {
     /// The mean score of `q` over the cameras, bit for bit [`Self::score`]'s, unless that
     /// mean cannot exceed `bar`: then the score is `None`, found without the terms that could
     /// not have lifted it over. Before each camera's silhouette term, and before each further
-    /// camera, the mean is bounded from above by the [`evaluate_edges`] bound for a camera
-    /// whose edges are scored and the [`ceiling`] for one not yet scored; a bound at or
+    /// camera, the mean is bounded from above by the `evaluate_edges` bound for a camera
+    /// whose edges are scored and the `ceiling` for one not yet scored; a bound at or
     /// under `bar` ends it. What was computed is counted in the result, so a caller can
     /// charge for it.
     pub fn score_above(

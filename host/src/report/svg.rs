@@ -50,7 +50,7 @@ impl Scale {
     }
 }
 
-/// Ticks covering `lo..hi`: a step of 1, 2 or 5 × 10ⁿ giving about [`TICKS`] ticks, and the
+/// Ticks covering `lo..hi`: a step of 1, 2 or 5 × 10ⁿ giving about `TICKS` ticks, and the
 /// tick values from the last multiple of the step at or below `lo` to the first at or above
 /// `hi`. A span that is empty or not finite is widened first.
 pub fn nice_ticks(lo: f64, hi: f64) -> (Vec<f64>, f64) {
