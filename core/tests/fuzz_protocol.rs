@@ -50,7 +50,7 @@ enum Owned {
     Ping(u32),
     Chunk(u32, u16, u16, u32, Vec<u8>),
     Reset(Vec<f32>, u32, bool),
-    Configure(u16, u8),
+    Configure(u16, u8, u8),
 }
 
 impl Owned {
@@ -71,7 +71,7 @@ impl Owned {
                 free: *free,
                 start: if *search { Start::Search } else { Start::Given },
             }),
-            Owned::Configure(budget, hypotheses) => HostMessage::Configure(Configure {
+            Owned::Configure(budget, hypotheses, every) => HostMessage::Configure(Configure {
                 camera: CameraParams {
                     width: 320,
                     height: 240,
@@ -84,6 +84,7 @@ impl Owned {
                 stats_every: 0,
                 search_evaluations_per_frame: *budget,
                 hypotheses: *hypotheses,
+                hypotheses_score_every: *every,
             }),
         }
     }
@@ -106,7 +107,7 @@ fn owned() -> impl Strategy<Value = Owned> {
             any::<bool>()
         )
             .prop_map(|(q, free, search)| Owned::Reset(q, free, search)),
-        (any::<u16>(), any::<u8>()).prop_map(|(b, k)| Owned::Configure(b, k)),
+        (any::<u16>(), any::<u8>(), any::<u8>()).prop_map(|(b, k, s)| Owned::Configure(b, k, s)),
     ]
 }
 

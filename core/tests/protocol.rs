@@ -174,6 +174,7 @@ fn host_messages(data: &[u8]) -> std::vec::Vec<HostMessage<'_>> {
             stats_every: u16::MAX,
             search_evaluations_per_frame: u16::MAX,
             hypotheses: u8::MAX,
+            hypotheses_score_every: u8::MAX,
         }),
         HostMessage::FrameChunk(FrameChunk {
             frame: u32::MAX,

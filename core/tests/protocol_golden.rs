@@ -42,6 +42,7 @@ fn host_messages(data: &[u8]) -> Vec<(&'static str, HostMessage<'_>)> {
                 stats_every: 30,
                 search_evaluations_per_frame: 1000,
                 hypotheses: 4,
+                hypotheses_score_every: 3,
             }),
         ),
         (
@@ -289,7 +290,7 @@ fn golden_host(name: &str) -> &'static [u8] {
             0x44, 0x08, 0x01, 0x05, 0x14, 0x01, 0x05, 0x80, 0x40, 0x02, 0x01, 0x01, 0x01, 0x02,
             0x40, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x07, 0x7a, 0x44, 0x9a,
             0x99, 0x99, 0x3e, 0x01, 0x08, 0xc0, 0x40, 0x01, 0x92, 0x0a, 0x06, 0x3f, 0x01, 0x01,
-            0x02, 0x3f, 0x09, 0x1e, 0xe8, 0x07, 0x04, 0x36, 0xbb, 0xa1, 0xd5, 0x00,
+            0x02, 0x3f, 0x0a, 0x1e, 0xe8, 0x07, 0x04, 0x03, 0x15, 0x8a, 0x64, 0x84, 0x00,
         ],
         "FrameChunk" => &[
             0x00, 0x05, 0x02, 0x07, 0x04, 0x02, 0x05, 0x08, 0x01, 0x02, 0x03, 0x09, 0xff, 0x04,
@@ -469,8 +470,26 @@ fn an_older_configure_is_a_decode_error(old: &[u8], grown: usize, why: &str) {
     assert_eq!(frame.len(), old.len() + grown, "{why}");
 }
 
+/// Version 8's `Configure` (no `hypotheses_score_every`), as a version 8 host sends it: a
+/// version 9 board counts it as a decode error and answers nothing.
+#[test]
+fn version_8_configure_is_a_decode_error() {
+    const V8_CONFIGURE: &[u8] = &[
+        0x00, 0x06, 0x01, 0xc0, 0x02, 0xf0, 0x01, 0x01, 0x03, 0xfa, 0x43, 0x01, 0x03, 0xfa, 0x43,
+        0x04, 0x80, 0x1f, 0x43, 0x01, 0x03, 0xef, 0x42, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x01, 0x01,
+        0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x01,
+        0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x03, 0x80, 0x3f, 0x01,
+        0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x07, 0x16, 0x44, 0x08, 0x01, 0x05, 0x14,
+        0x01, 0x05, 0x80, 0x40, 0x02, 0x01, 0x01, 0x01, 0x02, 0x40, 0x01, 0x03, 0x80, 0x3f, 0x01,
+        0x03, 0x80, 0x3f, 0x01, 0x07, 0x7a, 0x44, 0x9a, 0x99, 0x99, 0x3e, 0x01, 0x08, 0xc0, 0x40,
+        0x01, 0x92, 0x0a, 0x06, 0x3f, 0x01, 0x01, 0x02, 0x3f, 0x09, 0x1e, 0xe8, 0x07, 0x04, 0x36,
+        0xbb, 0xa1, 0xd5, 0x00,
+    ];
+    an_older_configure_is_a_decode_error(V8_CONFIGURE, 1, "one byte more: the score-every count");
+}
+
 /// Version 7's `Configure` (no `outermost_share` in its tracker parameters), as a version 7
-/// host sends it: a version 8 board counts it as a decode error and answers nothing.
+/// host sends it: a version 8 or 9 board counts it as a decode error and answers nothing.
 #[test]
 fn version_7_configure_is_a_decode_error() {
     const V7_CONFIGURE: &[u8] = &[
@@ -483,11 +502,15 @@ fn version_7_configure_is_a_decode_error() {
         0x03, 0x80, 0x3f, 0x01, 0x07, 0x7a, 0x44, 0x9a, 0x99, 0x99, 0x3e, 0x01, 0x08, 0xc0, 0x40,
         0x01, 0x92, 0x0a, 0x06, 0x3f, 0x09, 0x1e, 0xe8, 0x07, 0x04, 0xfa, 0xa2, 0xa8, 0xf4, 0x00,
     ];
-    an_older_configure_is_a_decode_error(V7_CONFIGURE, 4, "four bytes more: the share's f32");
+    an_older_configure_is_a_decode_error(
+        V7_CONFIGURE,
+        4 + 1,
+        "four bytes more for the share's f32, one for version 9's score-every count",
+    );
 }
 
 /// Version 6's `Configure` (no `max_edge_angle_rad` in its tracker parameters), as a version 6
-/// host sends it: a version 7 or 8 board counts it as a decode error and answers nothing.
+/// host sends it: a version 7 to 9 board counts it as a decode error and answers nothing.
 #[test]
 fn version_6_configure_is_a_decode_error() {
     const V6_CONFIGURE: &[u8] = &[
@@ -502,13 +525,14 @@ fn version_6_configure_is_a_decode_error() {
     ];
     an_older_configure_is_a_decode_error(
         V6_CONFIGURE,
-        4 + 4,
-        "four bytes more for the angle's f32, four for version 8's share",
+        4 + 4 + 1,
+        "four bytes more for the angle's f32, four for version 8's share, one for version 9's \
+         count",
     );
 }
 
 /// Version 5's `Configure` (no `palm_edges` in its tracker parameters), as a version 5 host
-/// sends it: a version 6 or 7 board counts it as a decode error and answers nothing.
+/// sends it: a version 6 to 9 board counts it as a decode error and answers nothing.
 #[test]
 fn version_5_configure_is_a_decode_error() {
     const V5_CONFIGURE: &[u8] = &[
@@ -523,8 +547,9 @@ fn version_5_configure_is_a_decode_error() {
     ];
     an_older_configure_is_a_decode_error(
         V5_CONFIGURE,
-        1 + 4 + 4,
-        "one byte more for the flag, four for version 7's angle, four for version 8's share",
+        1 + 4 + 4 + 1,
+        "one byte more for the flag, four for version 7's angle, four for version 8's share, \
+         one for version 9's count",
     );
 }
 
@@ -545,8 +570,9 @@ fn version_4_configure_is_a_decode_error() {
     ];
     an_older_configure_is_a_decode_error(
         V4_CONFIGURE,
-        2 + 4 + 4,
-        "the count, version 6's palm flag, version 7's angle and version 8's share",
+        2 + 4 + 4 + 1,
+        "the count, version 6's palm flag, version 7's angle, version 8's share and version \
+         9's score-every count",
     );
 }
 

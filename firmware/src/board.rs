@@ -330,12 +330,14 @@ where
             .tracker
             .to_config()
             .map_err(|_| Refusal::BadParameters)?;
-        if configure.search_evaluations_per_frame == 0 || !hypotheses_in_range(configure.hypotheses)
+        if configure.search_evaluations_per_frame == 0
+            || !hypotheses_in_range(configure.hypotheses)
+            || configure.hypotheses_score_every == 0
         {
             return Err(Refusal::BadParameters);
         }
         let acquire = search_config(configure.search_evaluations_per_frame);
-        let hypotheses = hypotheses_config(configure.hypotheses);
+        let hypotheses = hypotheses_config(configure.hypotheses, configure.hypotheses_score_every);
         if configure.camera.frame_bytes() > self.frame.len()
             || AutoTracker::edge_bytes_needed(&camera, &acquire) > self.edge_map.len()
         {

@@ -37,12 +37,14 @@ pub fn search_config(evaluations_per_frame: u16) -> AcquireConfig {
 }
 
 /// The hypotheses a board tracks: the tracker's defaults, `count` of them (`Configure`'s
-/// `hypotheses`), their likelihood's edge map at [`SEARCH_STRIDE_PX`] so it fits the
+/// `hypotheses`), scored one frame in `score_every_frames` (its `hypotheses_score_every`),
+/// their likelihood's edge map at [`SEARCH_STRIDE_PX`] so it fits the
 /// search's buffer ([`Buffers::edge_map`]).
-pub fn hypotheses_config(count: u8) -> HypothesesConfig {
+pub fn hypotheses_config(count: u8, score_every_frames: u8) -> HypothesesConfig {
     let defaults = HypothesesConfig::default();
     HypothesesConfig {
         count,
+        score_every_frames,
         likelihood: LikelihoodConfig {
             stride_px: SEARCH_STRIDE_PX,
             ..defaults.likelihood
@@ -86,7 +88,7 @@ mod tests {
     #[test]
     fn the_hypotheses_edge_map_fits_the_search_buffer() {
         for k in 1..=8u8 {
-            let config = hypotheses_config(k);
+            let config = hypotheses_config(k, 1);
             assert_eq!(config.count, k);
             assert_eq!(config.likelihood.stride_px, SEARCH_STRIDE_PX);
             for (w, h) in [(640, 480), (320, 240), (161, 119)] {

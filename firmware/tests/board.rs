@@ -29,6 +29,7 @@ fn configure(stats_every: u16, features_every: u16) -> HostMessage<'static> {
         stats_every,
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses: 1,
+        hypotheses_score_every: 1,
     })
 }
 
@@ -352,6 +353,7 @@ fn bad_commands_are_refused_and_change_nothing() {
         stats_every: 0,
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses: 1,
+        hypotheses_score_every: 1,
     }));
     params.iterations = 0;
     pipe.send(&HostMessage::Configure(Configure {
@@ -361,6 +363,7 @@ fn bad_commands_are_refused_and_change_nothing() {
         stats_every: 0,
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses: 1,
+        hypotheses_score_every: 1,
     }));
     let mut big = good_cam;
     big.width *= 2;
@@ -371,6 +374,7 @@ fn bad_commands_are_refused_and_change_nothing() {
         stats_every: 0,
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses: 1,
+        hypotheses_score_every: 1,
     }));
     pipe.send(&configure(0, 0));
     pipe.send(&HostMessage::Reset(Reset {

@@ -55,6 +55,7 @@ proptest! {
             stats_every: 1,
             search_evaluations_per_frame: default_search_evaluations(),
             hypotheses: 1,
+            hypotheses_score_every: 1,
         }));
         host.send(&HostMessage::Reset(Reset { q: q0.iter().copied().collect(), free: 0b1111_0000, start: Start::Given }));
         for n in 0..3 {

@@ -2,7 +2,9 @@
 //! with K > 1 answers each frame with its `State` and then a `Hypotheses` message, and both
 //! are bit-equal to an in-process `AutoTracker` with the same K on the same frames of a
 //! rendered whole hand; K = 1 sends no `Hypotheses`; K = 0 or more than `MAX_HYPOTHESES` is
-//! refused; a `Configure` that changes only K applies it from the next frame.
+//! refused; a `Configure` that changes only K applies it from the next frame. Scored one
+//! frame in S (protocol version 9), the board is bit-equal to the tracker in process with the
+//! same S, and S = 0 is refused.
 
 mod common;
 
@@ -23,7 +25,7 @@ fn free_all(model: &Model) -> u32 {
     (0..model.n_states()).map(|s| 1u32 << s).sum()
 }
 
-fn configure(hypotheses: u8) -> HostMessage<'static> {
+fn configure(hypotheses: u8, score_every: u8) -> HostMessage<'static> {
     HostMessage::Configure(Configure {
         camera: CameraParams::from_camera(&camera()).unwrap(),
         tracker: TrackerParams::default(),
@@ -31,14 +33,16 @@ fn configure(hypotheses: u8) -> HostMessage<'static> {
         stats_every: 0,
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses,
+        hypotheses_score_every: score_every,
     })
 }
 
-/// A board after boot, `Configure` with `k` hypotheses and `Reset` tracking from `q0`.
-fn started<'m>(buffer: &'m mut [u8], k: u8, q0: &[f32], free: u32) -> TestBoard<'m> {
+/// A board after boot, `Configure` with `k` hypotheses scored one frame in `s`, and `Reset`
+/// tracking from `q0`.
+fn started<'m>(buffer: &'m mut [u8], k: u8, s: u8, q0: &[f32], free: u32) -> TestBoard<'m> {
     let mut board = test_board("hypotheses", buffer);
     board.start().unwrap();
-    board.serial_mut().send(&configure(k));
+    board.serial_mut().send(&configure(k, s));
     board.serial_mut().send(&HostMessage::Reset(Reset {
         q: q0.iter().copied().collect(),
         free,
@@ -73,15 +77,16 @@ fn sequence(model: &Model) -> Vec<Vec<u8>> {
         .collect()
 }
 
-/// The board with `k` hypotheses against `AutoTracker` in process with the same `k`: every
-/// frame's `State` (state, status, report) and `Hypotheses` (scores, ages, states, best
-/// first) bit-equal. Returns the most hypotheses any frame carried.
-fn board_matches_in_process(k: u8) -> usize {
+/// The board with `k` hypotheses scored one frame in `s` against `AutoTracker` in process
+/// with the same `k` and `s`: every frame's `State` (state, status, report) and `Hypotheses`
+/// (scores, ages, states, best first) bit-equal. Returns the most hypotheses any frame
+/// carried.
+fn board_matches_in_process(k: u8, s: u8) -> usize {
     let model = Model::hand().unwrap();
     let q0 = pose(&model, 0.2);
     let free = free_all(&model);
     let mut buffer = vec![0u8; FRAME_BYTES];
-    let mut board = started(&mut buffer, k, &q0, free);
+    let mut board = started(&mut buffer, k, s, &q0, free);
     let tracker = TrackerParams::default().to_config().unwrap();
     let mut reference = AutoTracker::tracking(
         model.clone(),
@@ -92,7 +97,7 @@ fn board_matches_in_process(k: u8) -> usize {
         search_config(default_search_evaluations()),
     )
     .unwrap();
-    reference.set_hypotheses(hypotheses_config(k));
+    reference.set_hypotheses(hypotheses_config(k, s));
     let mut edges = vec![0u8; edge_map_bytes(WIDTH as usize, HEIGHT as usize)];
     let mut most = 0;
     for (n, pixels) in sequence(&model).iter().enumerate() {
@@ -155,13 +160,52 @@ fn board_matches_in_process(k: u8) -> usize {
 
 #[test]
 fn a_board_with_two_hypotheses_is_bit_equal_to_the_tracker_in_process() {
-    let most = board_matches_in_process(2);
+    let most = board_matches_in_process(2, 1);
     assert_eq!(most, 2, "two hypotheses were carried on some frame");
 }
 
 #[test]
+fn a_board_scoring_one_frame_in_three_is_bit_equal_to_the_tracker_in_process() {
+    let most = board_matches_in_process(2, 3);
+    assert_eq!(most, 2, "two hypotheses were carried on some frame");
+}
+
+/// Scored one frame in S, the hypotheses differ from those scored every frame: S reaches
+/// the board's tracker (the bit-equal test above would pass if both sides ignored it).
+#[test]
+fn scoring_one_frame_in_three_changes_what_the_board_carries() {
+    let model = Model::hand().unwrap();
+    let q0 = pose(&model, 0.2);
+    let free = free_all(&model);
+    let carried = |s: u8| {
+        let mut buffer = vec![0u8; FRAME_BYTES];
+        let mut board = started(&mut buffer, 2, s, &q0, free);
+        let mut all = Vec::new();
+        for (n, pixels) in sequence(&model).iter().enumerate() {
+            board
+                .serial_mut()
+                .send_frame(n as u32, WIDTH as u16, HEIGHT as u16, pixels);
+            board.poll().unwrap();
+            for message in board.serial_mut().received() {
+                if let BoardMessage::Hypotheses(h) = message {
+                    all.push(h.hypotheses.iter().map(hypothesis_bits).collect::<Vec<_>>());
+                }
+            }
+        }
+        all
+    };
+    let (every, one_in_three) = (carried(1), carried(3));
+    assert_eq!(every.len(), one_in_three.len());
+    assert_eq!(
+        every[0], one_in_three[0],
+        "the first frame is scored either way"
+    );
+    assert_ne!(every, one_in_three);
+}
+
+#[test]
 fn a_board_with_four_hypotheses_is_bit_equal_to_the_tracker_in_process() {
-    let most = board_matches_in_process(4);
+    let most = board_matches_in_process(4, 1);
     assert!(most >= 2, "several hypotheses were carried: at most {most}");
 }
 
@@ -170,7 +214,7 @@ fn one_hypothesis_sends_no_hypotheses_message() {
     let model = Model::hand().unwrap();
     let q0 = pose(&model, 0.2);
     let mut buffer = vec![0u8; FRAME_BYTES];
-    let mut board = started(&mut buffer, 1, &q0, free_all(&model));
+    let mut board = started(&mut buffer, 1, 1, &q0, free_all(&model));
     let pixels = render(&model, &camera(), &pose(&model, 0.22));
     board
         .serial_mut()
@@ -183,12 +227,12 @@ fn one_hypothesis_sends_no_hypotheses_message() {
 }
 
 #[test]
-fn configure_refuses_zero_hypotheses_and_more_than_the_capacity() {
+fn configure_refuses_zero_hypotheses_more_than_the_capacity_and_scoring_never() {
     for k in [0u8, MAX_HYPOTHESES as u8 + 1, u8::MAX] {
         let mut buffer = vec![0u8; FRAME_BYTES];
         let mut board = test_board("hypotheses", &mut buffer);
         board.start().unwrap();
-        board.serial_mut().send(&configure(k));
+        board.serial_mut().send(&configure(k, 1));
         board.poll().unwrap();
         assert!(
             board.serial_mut().received().ends_with(&[BoardMessage::Nak(
@@ -210,11 +254,24 @@ fn configure_refuses_zero_hypotheses_and_more_than_the_capacity() {
             "K = {k}"
         );
     }
+    // Scored one frame in none: refused.
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = test_board("hypotheses", &mut buffer);
+    board.start().unwrap();
+    board.serial_mut().send(&configure(2, 0));
+    board.poll().unwrap();
+    assert!(
+        board.serial_mut().received().ends_with(&[BoardMessage::Nak(
+            Command::Configure,
+            Refusal::BadParameters
+        )]),
+        "S = 0"
+    );
     // The largest count is taken.
     let mut buffer = vec![0u8; FRAME_BYTES];
     let mut board = test_board("hypotheses", &mut buffer);
     board.start().unwrap();
-    board.serial_mut().send(&configure(MAX_HYPOTHESES as u8));
+    board.serial_mut().send(&configure(MAX_HYPOTHESES as u8, 1));
     board.poll().unwrap();
     assert!(board
         .serial_mut()
@@ -230,11 +287,11 @@ fn a_configure_changing_only_the_count_applies_it_from_the_next_frame() {
     let model = Model::hand().unwrap();
     let q0 = pose(&model, 0.2);
     let mut buffer = vec![0u8; FRAME_BYTES];
-    let mut board = started(&mut buffer, 1, &q0, free_all(&model));
+    let mut board = started(&mut buffer, 1, 1, &q0, free_all(&model));
     let frames = sequence(&model);
     let mut kinds = Vec::new();
     for (n, (pixels, k)) in frames.iter().zip([1u8, 3, 3, 1]).enumerate() {
-        board.serial_mut().send(&configure(k));
+        board.serial_mut().send(&configure(k, 1));
         board
             .serial_mut()
             .send_frame(n as u32, WIDTH as u16, HEIGHT as u16, pixels);

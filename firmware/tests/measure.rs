@@ -34,6 +34,7 @@ fn configure() -> HostMessage<'static> {
         stats_every: 0,
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses: 1,
+        hypotheses_score_every: 1,
     })
 }
 

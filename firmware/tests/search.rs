@@ -39,6 +39,7 @@ fn configure(iterations: u8, budget: u16) -> HostMessage<'static> {
         stats_every: 0,
         search_evaluations_per_frame: budget,
         hypotheses: 1,
+        hypotheses_score_every: 1,
     })
 }
 

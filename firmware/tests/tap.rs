@@ -45,6 +45,7 @@ fn the_tap_sees_every_frame_of_a_pass_with_its_pixels_and_state() {
         stats_every: 0,
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses: 1,
+        hypotheses_score_every: 1,
     }));
     board.serial_mut().send(&HostMessage::Reset(Reset {
         q: q0.iter().copied().collect(),

@@ -18,7 +18,8 @@ use std::time::Duration;
 
 use anyhow::{anyhow, ensure, Context, Result};
 use digiteyes_core::protocol::{
-    default_hypotheses, default_search_evaluations, Start, State, TrackerParams,
+    default_hypotheses, default_hypotheses_score_every, default_search_evaluations, Start, State,
+    TrackerParams,
 };
 use digiteyes_core::status::Status;
 use digiteyes_core::tracker::FrameReport;
@@ -65,6 +66,8 @@ pub struct StreamOptions {
     /// Hypotheses the board's tracker carries (`Configure`, 1..=8): more than 1 makes it
     /// send them after every state; the summary counts them.
     pub hypotheses: u8,
+    /// The hypotheses are scored one frame in this many (`Configure`, at least 1).
+    pub hypotheses_score_every: u8,
     /// Show a progress bar (when stderr is a terminal).
     pub progress: bool,
 }
@@ -81,6 +84,7 @@ impl StreamOptions {
             start: None,
             search_evaluations_per_frame: default_search_evaluations(),
             hypotheses: default_hypotheses(),
+            hypotheses_score_every: default_hypotheses_score_every(),
             progress: false,
         }
     }
@@ -357,6 +361,7 @@ fn connect(sequence: &Sequence, options: &StreamOptions) -> Result<Session> {
     }
     setup.search_evaluations_per_frame = options.search_evaluations_per_frame;
     setup.hypotheses = options.hypotheses;
+    setup.hypotheses_score_every = options.hypotheses_score_every;
     setup.reply_timeout = options.reply_timeout;
     let link = Link::open(&options.port, options.baud)?;
     Session::start(link, setup)

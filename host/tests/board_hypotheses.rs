@@ -1,7 +1,9 @@
 //! Several hypotheses on a board through the `digiteyes` command (protocol version 5):
 //! `stream --hypotheses K` has a simulated board (the firmware's loop) carry K hypotheses and
 //! the summary count the `Hypotheses` messages that follow its states; `listen` prints each
-//! one and counts them; a count out of 1..=8, or with one board per camera, is refused clearly.
+//! one and counts them; a count out of 1..=8, or with one board per camera, is refused clearly;
+//! `--score-every S` (protocol version 9) reaches the board, and is refused where it means
+//! nothing.
 
 mod common;
 
@@ -58,6 +60,20 @@ fn stream_with_hypotheses_counts_what_the_board_carried() {
         "a whole hand carries more than one hypothesis: {line}"
     );
     assert!(line.contains("best's mean score 0."), "{line}");
+
+    // Scored one frame in two (protocol version 9), the board still sends one message a
+    // frame, and carries other hypotheses than when it scores every frame.
+    let every_other = run(&["--hypotheses", "3", "--score-every", "2"], "k3s2.csv");
+    assert!(
+        every_other.contains(&format!("hypotheses: {frames} messages")),
+        "{every_other}"
+    );
+    let read = |csv: &str| std::fs::read_to_string(dir.path().join(csv)).unwrap();
+    assert_ne!(
+        read("k3.csv"),
+        read("k3s2.csv"),
+        "--score-every 2 changed nothing"
+    );
 
     let single = run(&["--hypotheses", "1"], "k1.csv");
     assert!(
@@ -165,6 +181,40 @@ fn a_hypothesis_count_out_of_range_or_with_a_board_per_camera_is_refused_clearly
     );
     assert!(
         stderr.contains("--hypotheses") && stderr.contains("one board per camera"),
+        "{stderr}"
+    );
+    let stderr = common::refused(
+        dir.path(),
+        &[
+            "stream",
+            "--port",
+            "/nonexistent/a",
+            "--port",
+            "/nonexistent/b",
+            "--seq",
+            "stereo",
+            "--score-every",
+            "2",
+        ],
+    );
+    assert!(
+        stderr.contains("--score-every") && stderr.contains("one board per camera"),
+        "{stderr}"
+    );
+    let stderr = common::refused(
+        dir.path(),
+        &[
+            "stream",
+            "--port",
+            "/nonexistent/a",
+            "--seq",
+            "mono",
+            "--score-every",
+            "2",
+        ],
+    );
+    assert!(
+        stderr.contains("--score-every") && stderr.contains("only several hypotheses"),
         "{stderr}"
     );
 }

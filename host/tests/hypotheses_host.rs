@@ -77,6 +77,62 @@ fn hypotheses_1_writes_todays_states_byte_for_byte_and_bad_counts_are_refused() 
     assert!(!dir.path().join("bad.csv").exists());
 }
 
+/// `--score-every S` reaches the hypotheses: on a whole hand, K = 2 scored one frame in 3
+/// carries other hypotheses (`--hypotheses-out`: scores, ages, states) than K = 2 scored
+/// every frame, the same on a second run (deterministic), and the first frame's alike (it is
+/// scored either way). Without several hypotheses, or at 0, it is refused, naming the option.
+#[test]
+fn score_every_reaches_the_hypotheses_and_is_refused_where_it_means_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    render(dir.path(), "fullhand-mono", 7, (160, 120));
+    let track = |name: &str, extra: &[&str]| {
+        let (csv, carried) = (format!("{name}.csv"), format!("{name}-hypotheses.csv"));
+        let mut args = vec!["track", "seq", "-o", &csv, "-q", "--hypotheses", "2"];
+        args.extend_from_slice(&["--hypotheses-out", &carried]);
+        args.extend_from_slice(extra);
+        let out = digiteyes(&args, dir.path());
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        std::fs::read_to_string(dir.path().join(&carried)).unwrap()
+    };
+    let every = track("every", &[]);
+    let one_in_three = track("three", &["--score-every", "3"]);
+    let again = track("again", &["--score-every", "3"]);
+    assert_eq!(one_in_three, again, "the same run twice");
+    assert_ne!(every, one_in_three, "--score-every 3 changed nothing");
+    let first_frame = |csv: &str| -> Vec<String> {
+        csv.lines()
+            .skip(1)
+            .filter(|l| l.starts_with("0,"))
+            .map(str::to_owned)
+            .collect()
+    };
+    assert!(!first_frame(&every).is_empty());
+    assert_eq!(
+        first_frame(&every),
+        first_frame(&one_in_three),
+        "the first frame is scored either way"
+    );
+    for (args, why) in [
+        (vec!["--score-every", "3"], "only several hypotheses"),
+        (
+            vec!["--hypotheses", "1", "--score-every", "2"],
+            "only several hypotheses",
+        ),
+        (vec!["--hypotheses", "2", "--score-every", "0"], "0"),
+    ] {
+        let mut all = vec!["track", "seq", "-o", "bad.csv"];
+        all.extend_from_slice(&args);
+        let out = digiteyes(&all, dir.path());
+        let err = text(&out.stderr);
+        assert!(!out.status.success(), "{args:?} was taken");
+        assert!(
+            err.contains("--score-every") && err.contains(why),
+            "{args:?}: {err}"
+        );
+    }
+    assert!(!dir.path().join("bad.csv").exists());
+}
+
 /// The whole hand tracked with K = 4 from its given initial state, with the hypotheses CSV.
 struct Tracked {
     _dir: tempfile::TempDir,

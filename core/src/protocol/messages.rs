@@ -397,6 +397,13 @@ pub struct Configure {
     /// after every `State`. 0 or more than [`MAX_HYPOTHESES`] is refused
     /// (`Nak(Configure, BadParameters)`).
     pub hypotheses: u8,
+    /// With more than one hypothesis, they are scored, sampled around and merged on one frame
+    /// in this many, at least 1 (version 9; `hypotheses::HypothesesConfig::score_every_frames`;
+    /// default [`default_hypotheses_score_every`], every frame): the rest of K > 1's cost is
+    /// paid on those frames only, so a board can keep its frame rate with K = 2
+    /// (docs/hypotheses.md, "Scoring one frame in S"). 0 is refused
+    /// (`Nak(Configure, BadParameters)`); with one hypothesis it changes nothing.
+    pub hypotheses_score_every: u8,
 }
 
 /// The search budget per frame a host sends by default: the search's own default.
@@ -407,6 +414,11 @@ pub fn default_search_evaluations() -> u16 {
 /// The hypothesis count a host sends by default: the tracker's own default.
 pub fn default_hypotheses() -> u8 {
     HypothesesConfig::default().count
+}
+
+/// How often a host asks the hypotheses scored by default: the tracker's own default.
+pub fn default_hypotheses_score_every() -> u8 {
+    HypothesesConfig::default().score_every_frames.max(1)
 }
 
 /// Whether `count` is a hypothesis count a board takes: 1..=[`MAX_HYPOTHESES`].

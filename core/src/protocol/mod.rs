@@ -41,7 +41,9 @@ pub use params::{BadParameter, CameraParams, TrackerParams, WireResidual, WireRo
 /// Version 8: `TrackerParams` gained `outermost_share`, the slice search's choice of the
 /// outermost edge where the model expects the background outside (issue 9; docs/protocol.md
 /// §4).
-pub const PROTOCOL_VERSION: u8 = 8;
+/// Version 9: `Configure` gained `hypotheses_score_every`, the hypotheses scored one frame in
+/// S (issue 11; docs/protocol.md §11).
+pub const PROTOCOL_VERSION: u8 = 9;
 
 /// Largest `FrameChunk` payload (bytes).
 pub const MAX_CHUNK: usize = 1024;

@@ -87,6 +87,11 @@ pub struct StreamArgs {
     /// board only: with one board per camera the host tracks.
     #[arg(long, value_name = "K", value_parser = clap::value_parser!(u8).range(1..=MAX_HYPOTHESES as i64))]
     pub hypotheses: Option<u8>,
+    /// With --hypotheses K > 1: the board scores its hypotheses on one frame in S, 1 to 255
+    /// (default 1: every frame; protocol version 9), so K = 2 can keep a board's frame rate
+    /// (docs/hypotheses.md, "Scoring one frame in S").
+    #[arg(long, value_name = "S", value_parser = clap::value_parser!(u8).range(1..))]
+    pub score_every: Option<u8>,
     /// Output CSV path (default: states.csv in the current folder).
     #[arg(long, short, default_value = "states.csv", hide_default_value = true)]
     pub out: PathBuf,
@@ -152,11 +157,11 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
                  initial_state only (accepted: --init given); a single board searches itself"
             );
         }
-        if args.hypotheses.is_some() {
+        if args.hypotheses.is_some() || args.score_every.is_some() {
             bail!(
-                "--hypotheses: with one board per camera the host tracks, and its stereo \
-                 tracker carries one hypothesis; leave --hypotheses out, or stream one camera \
-                 to one board (--camera-index)"
+                "--hypotheses, --score-every: with one board per camera the host tracks, and \
+                 its stereo tracker carries one hypothesis; leave them out, or stream one \
+                 camera to one board (--camera-index)"
             );
         }
         if args.camera_index.is_some() {
@@ -187,6 +192,10 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
     }
     if let Some(k) = args.hypotheses {
         options.hypotheses = k;
+    }
+    if let Some(s) = args.score_every {
+        super::track::check_score_every(options.hypotheses, s)?;
+        options.hypotheses_score_every = s;
     }
     let summary = match (args.seq, args.camera, args.setup) {
         (Some(seq), None, _) => stream_sequence(&seq, &args.out, &options)?,

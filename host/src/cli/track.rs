@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 
 use super::tracker_config;
@@ -41,7 +41,9 @@ use digiteyes_core::hypotheses::HypothesesConfig;
 /// summary then says how many were carried on average and how often the best switched.
 /// --hypotheses-out FILE writes every hypothesis carried: one row per hypothesis per frame,
 /// `frame,rank,score,age,q0..` (rank 0 is the best, the output; a searching frame has no
-/// row). See docs/hypotheses.md.
+/// row). With --score-every S the hypotheses are scored, sampled around and merged on one
+/// frame in S only (and after a lost frame), and only tracked between: most of what K > 1
+/// costs, at a share of what it buys (docs/hypotheses.md, "Scoring one frame in S").
 #[derive(Args, Debug)]
 pub struct TrackArgs {
     /// Sequence folder.
@@ -75,6 +77,21 @@ pub struct TrackArgs {
     /// Also write every hypothesis carried, one row per hypothesis per frame, to FILE.
     #[arg(long, value_name = "FILE")]
     pub hypotheses_out: Option<PathBuf>,
+    /// With --hypotheses K > 1: score the hypotheses on one frame in S, 1 to 255 (default 1:
+    /// every frame).
+    #[arg(long, value_name = "S", default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..))]
+    pub score_every: u8,
+}
+
+/// Refuses `--score-every` above 1 for a single hypothesis, where it would change nothing.
+pub fn check_score_every(hypotheses: u8, score_every: u8) -> Result<()> {
+    if score_every > 1 && hypotheses <= 1 {
+        bail!(
+            "--score-every {score_every}: only several hypotheses are scored; give \
+             --hypotheses K with K > 1, or leave --score-every out"
+        );
+    }
+    Ok(())
 }
 
 /// `--hypotheses`' values: a whole number 1..=MAX_HYPOTHESES.
@@ -107,6 +124,7 @@ pub enum RecoverArg {
 
 /// Tracks the sequence and prints the summary; `progress`: a progress bar on stderr.
 pub fn run(args: TrackArgs, progress: bool) -> Result<()> {
+    check_score_every(args.hypotheses, args.score_every)?;
     let config = tracker_config(args.iterations, args.no_predict);
     let options = TrackOptions {
         init: args.init.map(|i| match i {
@@ -119,6 +137,7 @@ pub fn run(args: TrackArgs, progress: bool) -> Result<()> {
         },
         hypotheses: HypothesesConfig {
             count: args.hypotheses,
+            score_every_frames: args.score_every,
             ..HypothesesConfig::default()
         },
         ..TrackOptions::default()

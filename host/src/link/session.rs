@@ -304,6 +304,7 @@ impl Session {
             stats_every: self.setup.stats_every,
             search_evaluations_per_frame: self.setup.search_evaluations_per_frame,
             hypotheses: self.setup.hypotheses,
+            hypotheses_score_every: self.setup.hypotheses_score_every,
         });
         self.command(&configure, Command::Configure)?;
         // A search starts from the same base as the host's own (`track --init auto`).

@@ -5,8 +5,8 @@ use std::time::Duration;
 
 use anyhow::{anyhow, bail, Result};
 use digiteyes_core::protocol::{
-    default_hypotheses, default_search_evaluations, model_digest, CameraParams, Start,
-    TrackerParams,
+    default_hypotheses, default_hypotheses_score_every, default_search_evaluations, model_digest,
+    CameraParams, Start, TrackerParams,
 };
 
 use crate::sequence::Sequence;
@@ -42,6 +42,9 @@ pub struct SessionSetup {
     /// Hypotheses the board's tracker carries, 1..=8 (`Configure`; protocol version 5): more
     /// than 1 makes it send a `Hypotheses` message after every `State`.
     pub hypotheses: u8,
+    /// The hypotheses are scored one frame in this many, at least 1 (`Configure`; protocol
+    /// version 9).
+    pub hypotheses_score_every: u8,
     /// [`model_digest`] of the model the frames show; the board's must match.
     pub model_digest: u32,
     /// The model's name for messages (`sequence.json`'s `model`).
@@ -99,6 +102,7 @@ impl SessionSetup {
             },
             search_evaluations_per_frame: default_search_evaluations(),
             hypotheses: default_hypotheses(),
+            hypotheses_score_every: default_hypotheses_score_every(),
             model_digest: model_digest(&sequence.model),
             model_name: sequence.file.model.clone(),
             reply_timeout: DEFAULT_REPLY_TIMEOUT,
