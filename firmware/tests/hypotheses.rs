@@ -228,18 +228,24 @@ fn one_hypothesis_sends_no_hypotheses_message() {
 
 #[test]
 fn configure_refuses_zero_hypotheses_more_than_the_capacity_and_scoring_never() {
-    for k in [0u8, MAX_HYPOTHESES as u8 + 1, u8::MAX] {
+    // (K, S): no hypotheses, more than the capacity, and scored one frame in none.
+    for (k, s) in [
+        (0u8, 1u8),
+        (MAX_HYPOTHESES as u8 + 1, 1),
+        (u8::MAX, 1),
+        (2, 0),
+    ] {
         let mut buffer = vec![0u8; FRAME_BYTES];
         let mut board = test_board("hypotheses", &mut buffer);
         board.start().unwrap();
-        board.serial_mut().send(&configure(k, 1));
+        board.serial_mut().send(&configure(k, s));
         board.poll().unwrap();
         assert!(
             board.serial_mut().received().ends_with(&[BoardMessage::Nak(
                 Command::Configure,
                 Refusal::BadParameters
             )]),
-            "K = {k}"
+            "K = {k}, S = {s}"
         );
         // Refused: the board has no camera, so a Reset is refused too.
         board.serial_mut().send(&HostMessage::Reset(Reset {
@@ -251,22 +257,9 @@ fn configure_refuses_zero_hypotheses_more_than_the_capacity_and_scoring_never() 
         assert_eq!(
             board.serial_mut().received(),
             [BoardMessage::Nak(Command::Reset, Refusal::NotConfigured)],
-            "K = {k}"
+            "K = {k}, S = {s}"
         );
     }
-    // Scored one frame in none: refused.
-    let mut buffer = vec![0u8; FRAME_BYTES];
-    let mut board = test_board("hypotheses", &mut buffer);
-    board.start().unwrap();
-    board.serial_mut().send(&configure(2, 0));
-    board.poll().unwrap();
-    assert!(
-        board.serial_mut().received().ends_with(&[BoardMessage::Nak(
-            Command::Configure,
-            Refusal::BadParameters
-        )]),
-        "S = 0"
-    );
     // The largest count is taken.
     let mut buffer = vec![0u8; FRAME_BYTES];
     let mut board = test_board("hypotheses", &mut buffer);

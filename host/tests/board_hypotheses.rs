@@ -147,74 +147,43 @@ fn listen_prints_each_hypotheses_message_and_counts_them() {
 #[test]
 fn a_hypothesis_count_out_of_range_or_with_a_board_per_camera_is_refused_clearly() {
     let dir = tempfile::tempdir().unwrap();
-    for k in ["0", "9"] {
-        let stderr = common::refused(
-            dir.path(),
-            &[
-                "stream",
-                "--port",
-                "/nonexistent/a",
-                "--seq",
-                "mono",
-                "--hypotheses",
-                k,
-            ],
-        );
+    let one_board = ["--port", "/nonexistent/a", "--seq", "mono"];
+    let two_boards = [
+        "--port",
+        "/nonexistent/a",
+        "--port",
+        "/nonexistent/b",
+        "--seq",
+        "stereo",
+    ];
+    // (the boards, the options, what the error must name)
+    let cases: [(&[&str], [&str; 2], [&str; 2]); 5] = [
+        (&one_board, ["--hypotheses", "0"], ["--hypotheses", "1..=8"]),
+        (&one_board, ["--hypotheses", "9"], ["--hypotheses", "1..=8"]),
+        (
+            &two_boards,
+            ["--hypotheses", "2"],
+            ["--hypotheses", "one board per camera"],
+        ),
+        (
+            &two_boards,
+            ["--score-every", "2"],
+            ["--score-every", "one board per camera"],
+        ),
+        (
+            &one_board,
+            ["--score-every", "2"],
+            ["--score-every", "only several hypotheses"],
+        ),
+    ];
+    for (boards, options, named) in cases {
+        let mut args = vec!["stream"];
+        args.extend_from_slice(boards);
+        args.extend_from_slice(&options);
+        let stderr = common::refused(dir.path(), &args);
         assert!(
-            stderr.contains("--hypotheses") && stderr.contains("1..=8"),
-            "K = {k}: {stderr}"
+            named.iter().all(|n| stderr.contains(n)),
+            "{options:?}: {stderr}"
         );
     }
-    let stderr = common::refused(
-        dir.path(),
-        &[
-            "stream",
-            "--port",
-            "/nonexistent/a",
-            "--port",
-            "/nonexistent/b",
-            "--seq",
-            "stereo",
-            "--hypotheses",
-            "2",
-        ],
-    );
-    assert!(
-        stderr.contains("--hypotheses") && stderr.contains("one board per camera"),
-        "{stderr}"
-    );
-    let stderr = common::refused(
-        dir.path(),
-        &[
-            "stream",
-            "--port",
-            "/nonexistent/a",
-            "--port",
-            "/nonexistent/b",
-            "--seq",
-            "stereo",
-            "--score-every",
-            "2",
-        ],
-    );
-    assert!(
-        stderr.contains("--score-every") && stderr.contains("one board per camera"),
-        "{stderr}"
-    );
-    let stderr = common::refused(
-        dir.path(),
-        &[
-            "stream",
-            "--port",
-            "/nonexistent/a",
-            "--seq",
-            "mono",
-            "--score-every",
-            "2",
-        ],
-    );
-    assert!(
-        stderr.contains("--score-every") && stderr.contains("only several hypotheses"),
-        "{stderr}"
-    );
 }
