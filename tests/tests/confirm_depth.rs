@@ -12,13 +12,24 @@ use digiteyes_core::acquire::FinderConfig;
 mod common;
 use common::search::{self, acquire_mono, WITHIN_FRAMES};
 
-/// The search's defaults without the confirm phase's depth variants.
-fn without_depth_variants() -> FinderConfig {
+/// The search's defaults with one camera's depth variants at `share`.
+fn with_depth_share(share: f32) -> FinderConfig {
     FinderConfig {
-        confirm_depth_share: [0.0, 0.0],
+        confirm_depth_share: [0.0, share],
         ..FinderConfig::default()
     }
 }
+
+/// The search's defaults without the confirm phase's depth variants.
+fn without_depth_variants() -> FinderConfig {
+    with_depth_share(0.0)
+}
+
+/// The share the mechanism is shown with: these seeds' leaves lie about 12 % of the camera's
+/// distance off (96 and 164 mm). The default (0.08 since stop 55) was chosen on 3,600 fresh
+/// seeds by the acquisitions it wins (`docs/recovery.md`, "The depth share again"); at 0.08
+/// seed 4247 is acquired but its tips end at 11.9 px against 17.5 px without the variants.
+const SHOWN_SHARE: f32 = 0.12;
 
 #[test]
 fn the_confirm_phase_finds_the_depth_one_camera_misjudged() {
@@ -27,7 +38,7 @@ fn the_confirm_phase_finds_the_depth_one_camera_misjudged() {
         "one camera's confirm phase carries depth variants by default"
     );
     for seed in [4247, 4808] {
-        let with = acquire_mono(seed, FinderConfig::default());
+        let with = acquire_mono(seed, with_depth_share(SHOWN_SHARE));
         let without = acquire_mono(seed, without_depth_variants());
         assert_eq!(
             with.most_hypotheses,
