@@ -42,8 +42,9 @@ use digiteyes_core::hypotheses::HypothesesConfig;
 /// --hypotheses-out FILE writes every hypothesis carried: one row per hypothesis per frame,
 /// `frame,rank,score,age,q0..` (rank 0 is the best, the output; a searching frame has no
 /// row). With --score-every S the hypotheses are scored, sampled around and merged on one
-/// frame in S only (and after a lost frame), and only tracked between: most of what K > 1
-/// costs, at a share of what it buys (docs/hypotheses.md, "Scoring one frame in S").
+/// frame in S only (and after a lost frame), and only tracked between: K = 2 at S = 4 costs
+/// about half of K = 2's instructions a frame on the mean (docs/hypotheses.md, "Scoring one
+/// frame in S").
 #[derive(Args, Debug)]
 pub struct TrackArgs {
     /// Sequence folder.
