@@ -5,8 +5,10 @@
 //!   and scores hypotheses; when it is over, its best leaves are refined by the tracker's
 //!   Gauss–Newton on the frames that follow and judged by the likelihood in every camera
 //!   ([`AcceptConfig`]); an accepted leaf is taken for the hand — claimed from the next
-//!   frame, if that frame confirms it ([`FinderConfig::probation_max_drop`]) — and when
-//!   every leaf is refused the search starts over. With one camera, a refused leaf that
+//!   frame, if that frame confirms it ([`FinderConfig::probation_max_drop`]), and with one
+//!   camera not while the confirm phase still weighs two depths alike
+//!   ([`FinderConfig::confirm_rival_margin`]) — and when every leaf is refused the search
+//!   starts over. With one camera, a refused leaf that
 //!   scored at least [`FinderConfig::pursue_score`] is *pursued*: refined again and judged on
 //!   each of the next [`FinderConfig::pursue_frames`] searching frames ([`PURSUIT_PASSES`]
 //!   tracker pass a frame), beside the search, which spends [`PURSUIT_EVALUATIONS_PER_CAMERA`]
@@ -33,8 +35,9 @@
 //!   search run — or, with two or more cameras, sooner, once
 //!   [`FinderConfig::local_frames_in_view`] local frames have refined a start (the hand is
 //!   back in view) without accepting any.
-//! - While searching, [`AutoTracker::state`] holds the last state that claimed the hand (the
-//!   base state before the first acquisition), never a refused hypothesis.
+//! - While searching (and on the frames an acquisition is not yet claimed),
+//!   [`AutoTracker::state`] holds the last state that claimed the hand (the base state before
+//!   the first acquisition), never a refused hypothesis.
 //!
 //! The edge maps the search (and several hypotheses) need live in the caller's buffers, one
 //! per camera, of [`AutoTracker::edge_bytes_needed`] bytes; only searching frames, and
@@ -56,6 +59,8 @@ use crate::hypotheses::{HypothesesConfig, Hypothesis, MultiReport, MultiTracker}
 use crate::likelihood::{BuiltEdges, EdgeMap, LikelihoodConfig, LikelihoodError, Scene};
 use crate::model::Model;
 use crate::motion::PriorWeights;
+use crate::nalgebra::Vector3;
+use crate::state::TRANSLATION;
 pub use crate::status::Status;
 use crate::tracker::{FrameReport, Tracker, TrackerConfig, TrackerError};
 use crate::watch::{Watch, WatchConfig};
@@ -256,6 +261,14 @@ fn padded(state: &[f32]) -> [f32; MAX_STATES] {
     q
 }
 
+/// The palm's distance from the first camera (mm), if there is a camera and `state` has a
+/// palm position.
+fn palm_depth_mm(cameras: &[Camera], state: &[f32]) -> Option<f32> {
+    let camera = cameras.first()?;
+    let p = state.get(TRANSLATION)?;
+    Some((Vector3::new(p[0], p[1], p[2]) - camera.centre()).norm())
+}
+
 /// One edge map per camera: `frames[i]`'s, built into `edge_buffers[i]`.
 fn edge_maps<'b>(
     edge_buffers: &'b mut [&mut [u8]],
@@ -339,6 +352,12 @@ pub struct AutoTracker {
     polish_left: u8,
     /// A leaf accepted on the last frame, claimed only if this frame confirms it.
     probation: Option<Probation>,
+    /// While a confirm phase carries depth variants: how far apart (mm) two hypotheses' palms
+    /// must lie in depth to be rival readings of it ([`FinderConfig::confirm_rival_share`]).
+    rival_depth_mm: Option<f32>,
+    /// On the last frame a rival scored within [`FinderConfig::confirm_rival_margin`] of the
+    /// best: not claimed.
+    undecided: bool,
 }
 
 impl AutoTracker {
@@ -379,6 +398,8 @@ impl AutoTracker {
             confirm_scores: (0.0, 0),
             polish_left: 0,
             probation: None,
+            rival_depth_mm: None,
+            undecided: false,
         })
     }
 
@@ -461,9 +482,10 @@ impl AutoTracker {
     }
 
     /// The status after the last frame (searching while an accepted leaf awaits the next
-    /// frame's confirmation).
+    /// frame's confirmation, and while a confirm phase's best is
+    /// [undecided in depth](FinderConfig::confirm_rival_margin)).
     pub fn status(&self) -> Status {
-        if self.probation.is_some() {
+        if self.probation.is_some() || self.undecided {
             Status::Searching
         } else {
             self.status
@@ -491,6 +513,7 @@ impl AutoTracker {
         frames: &[FrameView<'_>],
         edge_buffers: &mut [&mut [u8]],
     ) -> Result<AutoReport, AutoError> {
+        self.undecided = false;
         match self.status {
             Status::Searching => self.search(frames, edge_buffers),
             Status::Tracking | Status::Lost => self.follow(frames, edge_buffers),
@@ -525,6 +548,7 @@ impl AutoTracker {
             }
         }
         let mut refuted = false;
+        let undecided = self.confirm_left > 0 && self.depth_undecided();
         if self.confirm_left > 0 {
             self.confirm_left -= 1;
             self.confirm_scores.0 += multi.score;
@@ -558,7 +582,9 @@ impl AutoTracker {
             };
             watch_score = Some(worst);
             if self.watch.judge(worst, reverse_px) {
-                self.vouched = self.multi.tracker().memory().state;
+                if !undecided {
+                    self.vouched = self.multi.tracker().memory().state;
+                }
             } else {
                 // The image does not support the track: a lost frame, and what was last
                 // vouched for is what the hand is held at.
@@ -589,13 +615,19 @@ impl AutoTracker {
             } else {
                 Status::Lost
             };
+        } else if undecided {
+            // Neither lost nor claimed: the confirm phase is still choosing the depth.
+            self.lost_run = 0;
+            self.status = Status::Tracking;
+            self.undecided = true;
+            report.lost = true;
         } else {
             self.lost_run = 0;
             self.status = Status::Tracking;
             self.hold_tracked();
         }
         Ok(AutoReport::tracked(
-            self.status,
+            self.status(),
             report,
             &multi,
             watch_score,
@@ -680,6 +712,37 @@ impl AutoTracker {
             None
         };
         Ok((worst, reverse_px))
+    }
+
+    /// Whether a hypothesis whose palm lies [`AutoTracker::rival_depth_mm`] or more nearer to
+    /// or farther from the first camera than the best's ranks within
+    /// [`FinderConfig::confirm_rival_margin`] of the best (a depth or score not a number
+    /// counts as such a rival); false without rivals to look for.
+    fn depth_undecided(&self) -> bool {
+        let Some(apart_mm) = self.rival_depth_mm else {
+            return false;
+        };
+        let tracker = self.multi.tracker();
+        let cameras = tracker.cameras();
+        let margin = self.finder.config().confirm_rival_margin;
+        let mut hypotheses = self.multi.hypotheses().iter();
+        let Some(best) = hypotheses.next() else {
+            return false;
+        };
+        let depth = |h: &Hypothesis| palm_depth_mm(cameras, &h.memory.state).unwrap_or(f32::NAN);
+        let ranked = |h: &Hypothesis| h.ranked_score.unwrap_or(h.score);
+        let (best_mm, best_score) = (depth(best), ranked(best));
+        // A depth or score not a number counts as a rival's.
+        let apart = |h: &Hypothesis| {
+            let mm = (depth(h) - best_mm).abs();
+            mm.is_nan() || mm >= apart_mm
+        };
+        let alike = |h: &Hypothesis| {
+            let floor = best_score - margin;
+            let score = ranked(h);
+            floor.is_nan() || score.is_nan() || score >= floor
+        };
+        hypotheses.any(|h| apart(h) && alike(h))
     }
 
     /// Keeps the tracker's state as the last that claimed the hand.
@@ -805,6 +868,10 @@ impl AutoTracker {
         } else {
             None
         };
+        self.rival_depth_mm = depth_share.and_then(|_| {
+            let depth_mm = palm_depth_mm(tracker.cameras(), tracker.state())?;
+            finder.confirm_rival_mm(tracker.cameras().len(), depth_mm)
+        });
         let mut carried: Vec<[f32; MAX_STATES], { MAX_KEEP + DEPTH_VARIANTS as usize }> =
             Vec::new();
         if let Some(share) = depth_share {

@@ -1,5 +1,6 @@
 //! `FinderConfig`'s derived settings: which confirm-phase depth share applies to a rig, and
-//! how many hypotheses the confirm phase may then carry.
+//! how many hypotheses the confirm phase may then carry, and how far its best may lie in depth
+//! and be claimed.
 
 use digiteyes_core::acquire::{FinderConfig, DEPTH_VARIANTS};
 
@@ -54,4 +55,49 @@ fn the_capacity_saturates_instead_of_overflowing() {
         ..FinderConfig::default()
     };
     assert_eq!(f.confirm_capacity(1), u8::MAX);
+}
+
+#[test]
+fn rival_depths_lie_a_share_of_the_variants_offset_apart() {
+    let f = FinderConfig {
+        confirm_rival_share: 0.5,
+        confirm_rival_margin: 0.005,
+        ..with_shares(0.0, 0.1)
+    };
+    let apart = f
+        .confirm_rival_mm(1, 1000.0)
+        .expect("one camera carries variants");
+    assert!((apart - 50.0).abs() < 1e-3, "half of 10 % of 1 m: {apart}");
+    assert_eq!(
+        f.confirm_rival_mm(2, 1000.0),
+        None,
+        "no variants, no rivals"
+    );
+    for off in [0.0, -0.5, f32::NAN] {
+        let share_off = FinderConfig {
+            confirm_rival_share: off,
+            ..f
+        };
+        assert_eq!(
+            share_off.confirm_rival_mm(1, 1000.0),
+            None,
+            "share {off}: off"
+        );
+    }
+    for off in [-0.001, f32::NAN] {
+        let margin_off = FinderConfig {
+            confirm_rival_margin: off,
+            ..f
+        };
+        assert_eq!(
+            margin_off.confirm_rival_mm(1, 1000.0),
+            None,
+            "margin {off}: off"
+        );
+    }
+    let never_claimed = FinderConfig {
+        confirm_rival_margin: f32::INFINITY,
+        ..f
+    };
+    assert!(never_claimed.confirm_rival_mm(1, 1000.0).is_some());
 }

@@ -46,7 +46,9 @@ use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig, Scene, StateScorer};
 use digiteyes_core::model::{Model, Shape};
+use digiteyes_core::state::TRANSLATION;
 use digiteyes_core::tracker::Tracker;
+use digiteyes_host::bench::robustness::FAR_PALM_MM;
 use digiteyes_host::render::hand_free::{hand_free, hand_free_frame, KINDS};
 use digiteyes_host::scenarios::RenderOptions;
 use digiteyes_host::sequence::Sequence;
@@ -190,6 +192,11 @@ struct Args {
     /// with one camera (default: the search's; two cameras keep theirs).
     #[arg(long)]
     confirm_depth: Option<f32>,
+    /// The margin within which a hypothesis at a rival depth leaves a confirm frame
+    /// unclaimed (default: the search's; negative: every frame claimed; `inf`: none while
+    /// rivals are carried).
+    #[arg(long, allow_hyphen_values = true)]
+    confirm_rival_margin: Option<f32>,
     /// The score a refused leaf needs to be pursued: two cameras, one camera (`A,B`; default:
     /// the search's)
     #[arg(long, value_delimiter = ',')]
@@ -339,6 +346,8 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             f.confirm_depth_share[0],
             args.confirm_depth.unwrap_or(f.confirm_depth_share[1]),
         ],
+        confirm_rival_share: f.confirm_rival_share,
+        confirm_rival_margin: args.confirm_rival_margin.unwrap_or(f.confirm_rival_margin),
         pursue_score: match args.pursue_score.as_deref() {
             Some([two, one]) => [*two, *one],
             _ => f.pursue_score,
@@ -423,6 +432,10 @@ struct Run {
     first_claim: Option<(usize, f32)>,
     /// Frames claimed with a tip error over the limit.
     wrong_frames: usize,
+    /// Frames claimed with the palm over [`FAR_PALM_MM`] from the truth.
+    far_frames: usize,
+    /// Frames claimed.
+    claimed_frames: usize,
     evaluations: u64,
     refined: u32,
 }
@@ -673,6 +686,8 @@ fn run(
         acquired: None,
         first_claim: None,
         wrong_frames: 0,
+        far_frames: 0,
+        claimed_frames: 0,
         evaluations: 0,
         refined: 0,
     };
@@ -772,8 +787,17 @@ fn run(
         if claimed && out.first_claim.is_none() {
             out.first_claim = Some((k, e));
         }
+        out.claimed_frames += usize::from(claimed);
         if claimed && e > limit {
             out.wrong_frames += 1;
+        }
+        let palm_mm = TRANSLATION
+            .map(|i| (auto.state()[i] - truth_k[i]).powi(2))
+            .sum::<f32>()
+            .sqrt();
+        // A palm not a number counts as far.
+        if claimed && (palm_mm.is_nan() || f64::from(palm_mm) > FAR_PALM_MM) {
+            out.far_frames += 1;
         }
         good.push(claimed && e <= limit);
     }
@@ -1179,11 +1203,13 @@ fn main() -> Result<()> {
             .collect();
         errors.sort_by(f32::total_cmp);
         let wrong: usize = runs.iter().map(|r| r.wrong_frames).sum();
+        let far: usize = runs.iter().map(|r| r.far_frames).sum();
+        let claimed: usize = runs.iter().map(|r| r.claimed_frames).sum();
         let pct = |v: &[usize], p: usize| v.get((v.len().max(1) - 1) * p / 100).copied();
         println!(
             "{rig}: acquired {}/{n} ({:.0} %); frames to acquire: min {:?}, median {:?}, max {:?}; \
              first claim's tip error (px at {w}): median {:?}, max {:?}; {} of {n} runs claimed; \
-             {wrong} claimed frames wrong",
+             of {claimed} claimed frames {wrong} wrong, {far} far (palm over {FAR_PALM_MM} mm)",
             frames.len(),
             100.0 * frames.len() as f32 / n.max(1) as f32,
             frames.first(),

@@ -7,7 +7,7 @@
 //! kernel's px; `k`, `s`, `spawn`, `step`, `smem`, `switch` the hypotheses (their count, scoring
 //! period, samples, their step in spread units, score memory, switch margin); `csmem`, `cswitch` the confirm phase's score
 //! memory and switch margin; `settle` the frames without the palm's position prior after an
-//! acquisition; `cdepth1` one camera's confirm-phase depth share; `cframes` its frames; `watch`
+//! acquisition; `cdepth1` one camera's confirm-phase depth share; `rival` the share of its offset that makes two hypotheses rival depths, `rivalm` the margin within which a rival leaves a confirm frame unclaimed (negative: all claimed); `cframes` its frames; `watch`
 //! its period, `drop` its bar; `depth1` one camera's local depth share; `turn` the local
 //! re-acquisition's palm turn (rad); `probation` the acceptance's probation drop, negative:
 //! off; `budget` the search's evaluations a frame and camera; `pursue1` the searching frames
@@ -50,6 +50,10 @@ struct Args {
     parity: Option<u64>,
     #[arg(long, default_value_t = 2)]
     jobs: usize,
+    /// Keep each run's states here, as `VARIANT/seedN.csv` (`track`'s output), to look at
+    /// frame by frame.
+    #[arg(long)]
+    states_out: Option<PathBuf>,
 }
 
 fn main() -> Result<()> {
@@ -85,6 +89,14 @@ fn main() -> Result<()> {
                 let judged = count_run(dir, &out, &report)?;
                 Ok((report, judged))
             });
+            if let (Ok(_), Some(keep)) = (&r, &args.states_out) {
+                let dir = keep.join(name);
+                let kept = std::fs::create_dir_all(&dir)
+                    .and_then(|_| std::fs::copy(&out, dir.join(format!("seed{seed}.csv"))));
+                if let Err(e) = kept {
+                    eprintln!("seed {seed}: its states not kept: {e}");
+                }
+            }
             let _ = std::fs::remove_file(&out);
             match r {
                 Ok((r, judged)) => {

@@ -38,13 +38,12 @@ fn a_refused_leaf_pursued_over_the_next_frames_is_acquired() {
     for seed in [10224, 10236] {
         let with = acquire_mono(seed, unbarred());
         let without = acquire_mono(seed, without_pursuit());
-        println!(
-            "seed {seed} with the pursuit: {}",
-            search::format_errors(&with.errors)
-        );
-        println!(
-            "seed {seed} without it: {}",
-            search::format_errors(&without.errors)
+        search::print_runs(
+            seed,
+            &[
+                ("with the pursuit", &with.errors),
+                ("without it", &without.errors),
+            ],
         );
         assert!(
             with.held.is_some(),

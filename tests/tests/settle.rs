@@ -31,10 +31,12 @@ fn an_acquisition_settles_onto_the_hand_without_the_position_prior() {
         let (held, errors) = (settled.held, settled.errors);
         let with_prior = acquire_mono(seed, settling(0));
         let (held_with_prior, errors_with_prior) = (with_prior.held, with_prior.errors);
-        println!("seed {seed} settling: {}", search::format_errors(&errors));
-        println!(
-            "seed {seed} with the prior: {}",
-            search::format_errors(&errors_with_prior)
+        search::print_runs(
+            seed,
+            &[
+                ("settling", &errors),
+                ("with the prior", &errors_with_prior),
+            ],
         );
         assert!(
             held.is_some(),

@@ -139,6 +139,22 @@ pub struct FinderConfig {
     /// track had: there a variant was taken 80–95 mm off and held, unflagged
     /// (`docs/recovery.md`, "One camera's confirm phase tries the depth again").
     pub confirm_depth_share: [f32; 2],
+    /// While the confirm phase carries the depth variants, two hypotheses whose palms lie
+    /// this share of the variants' offset or more apart in depth (along the first camera's
+    /// ray) are rival readings of the depth (default 0.5: 4 % of the distance at the default
+    /// share); not a number, or ≤ 0: none are.
+    pub confirm_rival_share: f32,
+    /// A confirm frame on which a rival of the best hypothesis
+    /// ([`FinderConfig::confirm_rival_share`]) ranks within this of it is *undecided*: not
+    /// claimed (reported searching and lost, the last claimed state held), as on probation;
+    /// the tracking goes on unchanged. One camera sees depth only through the hand's size,
+    /// and a leaf 125 mm beyond the hand scored level with its variant at the hand's depth to
+    /// four decimals. Default 0.005 on the running mean, about one frame's noise: on 2,400
+    /// fresh mono acquisitions, 12 % fewer frames claimed with the palm over 100 mm off, the
+    /// claim four or five frames later on a quarter of them (`docs/recovery.md`, "A confirm
+    /// phase that weighs two depths alike"). Negative or NaN: every frame claimed; infinite:
+    /// none while a rival is carried.
+    pub confirm_rival_margin: f32,
     /// A leaf of the global search refused by the acceptance but scoring at least this, with
     /// two or more cameras (`[0]`) and with one (`[1]`), is pursued: refined again on each of
     /// the next [`FinderConfig::pursue_frames`] searching frames (one tracker pass a frame),
@@ -173,6 +189,17 @@ impl FinderConfig {
     pub fn confirm_depth(&self, n_cameras: usize) -> Option<f32> {
         let share = self.confirm_depth_share[usize::from(n_cameras < 2)];
         (share > 0.0 && share < 1.0).then_some(share)
+    }
+
+    /// How far apart (mm) in depth two confirm-phase hypotheses are rivals after an
+    /// acceptance `leaf_depth_mm` from the first camera with `n_cameras` cameras
+    /// ([`FinderConfig::confirm_rival_share`]); `None`: no rivals (no depth variants, the
+    /// share off, or the margin negative or NaN).
+    pub fn confirm_rival_mm(&self, n_cameras: usize, leaf_depth_mm: f32) -> Option<f32> {
+        let variants = self.confirm_depth(n_cameras)?;
+        let share = self.confirm_rival_share;
+        (share > 0.0 && self.confirm_rival_margin >= 0.0)
+            .then_some(share * variants * leaf_depth_mm)
     }
 
     /// Hypotheses the confirm phase may carry after the global search's acceptance with
@@ -255,6 +282,8 @@ impl Default for FinderConfig {
             confirm_score_memory: 0.6,
             settle_frames: 15,
             confirm_depth_share: [0.0, 0.08],
+            confirm_rival_share: 0.5,
+            confirm_rival_margin: 0.005,
             pursue_score: [0.85, 0.88],
             pursue_frames: [0, 2],
             polish_margin: [0.0, -1.0],

@@ -127,6 +127,8 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "cswitch" => o.finder.confirm_switch_margin = f,
             "settle" => o.finder.settle_frames = f as u8,
             "cdepth1" => o.finder.confirm_depth_share[1] = f,
+            "rival" => o.finder.confirm_rival_share = f,
+            "rivalm" => o.finder.confirm_rival_margin = f,
             "cframes" => o.finder.confirm_frames = f as u8,
             "polish1" => o.finder.polish_margin[1] = f,
             "polish2" => o.finder.polish_margin[0] = f,

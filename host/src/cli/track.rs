@@ -24,8 +24,9 @@ use digiteyes_core::hypotheses::HypothesesConfig;
 ///
 /// Output columns: frame, q0..q{n-1} (unit quaternion, mm, rad), rms_px, iterations,
 /// features_found, features_expected, lost (0/1: 1 on every frame that claims no hand,
-/// searching or lost), status (searching, tracking or lost). While searching, the states
-/// are the last tracked ones (the search's base state before the first acquisition).
+/// searching or lost), status (searching, tracking or lost; a hand found shows as searching
+/// until it is confirmed). While searching, the states are the last tracked ones (the
+/// search's base state before the first acquisition).
 /// Prints a summary (frames, lost frames, mean RMS residual, frames per status, the
 /// frames where the hand was acquired, lost and re-acquired, frames/s). Exits non-zero,
 /// naming the file or frame, on bad input or a tracker error.

@@ -10,6 +10,8 @@ use digiteyes_core::frame::FrameView;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig, Scene};
 use digiteyes_core::model::{Model, Shape};
+use digiteyes_core::nalgebra::Vector3;
+use digiteyes_core::state::TRANSLATION;
 use digiteyes_core::tracker::TrackerConfig;
 use digiteyes_host::sequence::Sequence;
 
@@ -92,6 +94,14 @@ pub fn edge_maps<'b>(
         .collect()
 }
 
+/// The distance (mm) between the palm positions of states `a` and `b`.
+pub fn palm_error_mm(a: &[f32], b: &[f32]) -> f32 {
+    TRANSLATION
+        .map(|i| (a[i] - b[i]).powi(2))
+        .sum::<f32>()
+        .sqrt()
+}
+
 /// Mean fingertip distance (px) between states `a` and `b` over every camera.
 pub fn tip_error_px(model: &Model, cameras: &[Camera], a: &[f32], b: &[f32]) -> f32 {
     let (pa, pb) = (
@@ -121,6 +131,13 @@ pub struct MonoRun {
     pub held: Option<usize>,
     /// Every frame's tip error (px) while claimed.
     pub errors: Vec<Option<f32>>,
+    /// Every frame's palm position error (mm) while claimed.
+    pub palm_errors_mm: Vec<Option<f32>>,
+    /// The first frame a leaf was accepted on (claimed then or later), if any.
+    pub accepted: Option<usize>,
+    /// Every frame's hypotheses carried, best first: each palm's distance from the first
+    /// camera (mm) and its ranked score.
+    pub carried: Vec<Vec<(f32, f32)>>,
     /// The most hypotheses carried on any frame.
     pub most_hypotheses: usize,
 }
@@ -145,6 +162,9 @@ pub fn acquire_mono(seed: u64, finder: FinderConfig) -> MonoRun {
     auto.set_finder(finder);
     let own = TrackerConfig::default();
     let mut errors = Vec::new();
+    let mut palm_errors_mm = Vec::new();
+    let mut accepted = None;
+    let mut carried = Vec::new();
     let mut most_hypotheses = 0;
     for (k, true_state) in truth.iter().enumerate() {
         let images = frames::images(&sequence, k);
@@ -156,12 +176,27 @@ pub fn acquire_mono(seed: u64, finder: FinderConfig) -> MonoRun {
             "seed {seed} frame {k}: the tracker's own configuration, prior and all"
         );
         most_hypotheses = most_hypotheses.max(auto.hypotheses().len());
+        let eye = sequence.cameras[0].centre();
+        carried.push(
+            auto.hypotheses()
+                .iter()
+                .map(|h| {
+                    let p = &h.memory.state[TRANSLATION];
+                    let depth_mm = (Vector3::new(p[0], p[1], p[2]) - eye).norm();
+                    (depth_mm, h.ranked_score.unwrap_or(h.score))
+                })
+                .collect(),
+        );
+        if r.accepted && accepted.is_none() {
+            accepted = Some(k);
+        }
         let claimed = r.status != Status::Searching && !r.report.lost;
         errors.push(
             claimed.then(|| {
                 tip_error_px(&sequence.model, &sequence.cameras, auto.state(), true_state)
             }),
         );
+        palm_errors_mm.push(claimed.then(|| palm_error_mm(auto.state(), true_state)));
     }
     let on_hand: Vec<bool> = errors
         .iter()
@@ -175,7 +210,17 @@ pub fn acquire_mono(seed: u64, finder: FinderConfig) -> MonoRun {
     MonoRun {
         held,
         errors,
+        palm_errors_mm,
+        accepted,
+        carried,
         most_hypotheses,
+    }
+}
+
+/// Prints each labelled run's claimed frames' tip errors for a test's log, one line each.
+pub fn print_runs(seed: u64, runs: &[(&str, &[Option<f32>])]) {
+    for (label, errors) in runs {
+        println!("seed {seed} {label}: {}", format_errors(errors));
     }
 }
 
