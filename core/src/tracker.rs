@@ -419,11 +419,12 @@ impl Tracker {
         }
         report.silhouette_agreement = self.silhouette_agreement(measurer);
         let drop = self.config.lost_silhouette_drop;
+        let mut silhouette_dropped = false;
         if drop > 0.0 {
             let reference = *self
                 .silhouette_reference
                 .get_or_insert(report.silhouette_agreement);
-            report.lost |= report.silhouette_agreement < reference - drop;
+            silhouette_dropped = report.silhouette_agreement < reference - drop;
         }
         let found = f32::from(report.features_found);
         let expected = f32::from(report.features_expected).max(1.0);
@@ -435,7 +436,13 @@ impl Tracker {
             report.lost = true;
         }
         let motion = &self.config.motion;
-        if finite && !(report.lost && motion.hold_when_lost) {
+        // Lost on the silhouette check alone: the estimate may be kept, without velocity.
+        let kept_unheld = !report.lost && silhouette_dropped && !motion.hold_on_silhouette_drop;
+        report.lost |= silhouette_dropped;
+        if kept_unheld {
+            self.velocity = None;
+            self.state = q;
+        } else if finite && !(report.lost && motion.hold_when_lost) {
             let trust = velocity_trust(
                 found / expected,
                 self.config.lost_min_found,

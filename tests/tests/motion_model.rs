@@ -112,6 +112,58 @@ fn a_lost_track_holds_its_last_good_state() {
     assert_ne!(last, &good, "the plain tracker was expected to drift");
 }
 
+/// A frame lost on the silhouette check alone (its edges and tips found) is held by default;
+/// with `MotionConfig::hold_on_silhouette_drop` off it keeps the estimate it ended with,
+/// flagged lost all the same. The check is made touchy here (any fall below its reference
+/// flags the frame) so that a right track trips it.
+#[test]
+fn a_frame_lost_on_the_silhouette_alone_is_held_unless_told_otherwise() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = mouse(dir.path(), 20);
+    let truth = seq.read_truth().unwrap();
+    let run = |hold: bool| {
+        let mut config = robust_config();
+        config.lost_silhouette_drop = 1e-6;
+        config.motion.hold_on_silhouette_drop = hold;
+        let mut t = tracker(&seq, config);
+        let mut frames = Vec::new();
+        for k in 0..20 {
+            let before = t.state().to_vec();
+            let image = seq.read_frame(0, k).unwrap();
+            let report = t.track(&[view(&image)]).unwrap();
+            let found = f32::from(report.features_found)
+                >= config.lost_min_found * f32::from(report.features_expected);
+            let truth: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
+            let error = fingertip_px(&seq.model, &seq.cameras[0], t.state(), &truth);
+            frames.push((report.lost, found, before != t.state(), error));
+        }
+        frames
+    };
+    let held = run(true);
+    let kept = run(false);
+    let silhouette_only = |f: &&(bool, bool, bool, f32)| f.0 && f.1;
+    assert!(
+        held.iter().filter(silhouette_only).count() > 0,
+        "the touchy check flags some frame whose features were found"
+    );
+    for (k, f) in held.iter().enumerate().filter(|(_, f)| silhouette_only(f)) {
+        assert!(!f.2, "frame {k}: flagged on the silhouette alone and held");
+    }
+    let first = held.iter().position(|f| silhouette_only(&f)).unwrap();
+    assert_eq!(
+        held[..first],
+        kept[..first],
+        "the same track up to the first such frame"
+    );
+    let (lost, found, moved, error) = kept[first];
+    assert!(lost && found, "frame {first}: flagged lost all the same");
+    assert!(moved, "frame {first}: its estimate kept");
+    assert!(
+        error < held[first].3,
+        "frame {first}: nearer the truth than held ({error:.2} px)"
+    );
+}
+
 #[test]
 fn a_wrong_track_is_flagged_within_five_frames_and_a_right_one_is_not() {
     let dir = tempfile::tempdir().unwrap();

@@ -94,6 +94,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "fillend" => c.fill.full_length_widths = f,
             "lostrms" => c.lost_rms_px = f,
             "sdrop" => c.lost_silhouette_drop = f,
+            "shold" => c.motion.hold_on_silhouette_drop = f != 0.0,
             "minfound" => c.lost_min_found = f,
             "huber" => c.estimator.robust = Robust::Huber(f),
             "tukey" => c.estimator.robust = Robust::Tukey(f),
