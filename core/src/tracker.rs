@@ -437,7 +437,10 @@ impl Tracker {
         }
         let motion = &self.config.motion;
         // Lost on the silhouette check alone: the estimate may be kept, without velocity.
-        let kept_unheld = !report.lost && silhouette_dropped && !motion.hold_on_silhouette_drop;
+        let kept_unheld = motion.hold_when_lost
+            && !motion.hold_on_silhouette_drop
+            && silhouette_dropped
+            && !report.lost;
         report.lost |= silhouette_dropped;
         if kept_unheld {
             self.velocity = None;
