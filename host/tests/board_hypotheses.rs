@@ -148,14 +148,7 @@ fn listen_prints_each_hypotheses_message_and_counts_them() {
 fn a_hypothesis_count_out_of_range_or_with_a_board_per_camera_is_refused_clearly() {
     let dir = tempfile::tempdir().unwrap();
     let one_board = ["--port", "/nonexistent/a", "--seq", "mono"];
-    let two_boards = [
-        "--port",
-        "/nonexistent/a",
-        "--port",
-        "/nonexistent/b",
-        "--seq",
-        "stereo",
-    ];
+    let two_boards = [&common::TWO_ABSENT_BOARDS[..], &["--seq", "stereo"]].concat();
     // (the boards, the options, what the error must name)
     let cases: [(&[&str], [&str; 2], [&str; 2]); 5] = [
         (&one_board, ["--hypotheses", "0"], ["--hypotheses", "1..=8"]),

@@ -135,20 +135,13 @@ fn stream_init_auto_has_a_simulated_board_search_and_writes_the_status() {
 #[test]
 fn init_auto_with_one_board_per_camera_is_refused_clearly() {
     let dir = tempfile::tempdir().unwrap();
-    let stderr = common::refused(
-        dir.path(),
-        &[
-            "stream",
-            "--port",
-            "/nonexistent/a",
-            "--port",
-            "/nonexistent/b",
-            "--seq",
-            "stereo",
-            "--init",
-            "auto",
-        ],
-    );
+    let args = [
+        &["stream"][..],
+        &common::TWO_ABSENT_BOARDS,
+        &["--seq", "stereo", "--init", "auto"],
+    ]
+    .concat();
+    let stderr = common::refused(dir.path(), &args);
     assert!(
         stderr.contains("--init auto") && stderr.contains("accepted: --init given"),
         "{stderr}"

@@ -323,18 +323,8 @@ fn one_board_per_camera_needs_as_many_ports_as_cameras_and_a_sequence() {
     let seq = sequence(dir.path(), 2);
     let seq = seq.to_str().unwrap();
     // A one-camera sequence and two ports: refused before any port is opened.
-    let out = digiteyes(
-        &[
-            "stream",
-            "--port",
-            "/nonexistent/a",
-            "--port",
-            "/nonexistent/b",
-            "--seq",
-            seq,
-        ],
-        dir.path(),
-    );
+    let ports = &common::TWO_ABSENT_BOARDS[..];
+    let out = digiteyes(&[&["stream"], ports, &["--seq", seq]].concat(), dir.path());
     assert!(!out.status.success());
     let err = stderr(&out);
     assert!(
@@ -344,16 +334,11 @@ fn one_board_per_camera_needs_as_many_ports_as_cameras_and_a_sequence() {
     // Two ports without a sequence.
     let out = digiteyes(
         &[
-            "stream",
-            "--port",
-            "/nonexistent/a",
-            "--port",
-            "/nonexistent/b",
-            "--camera",
-            "/dev/null",
-            "--setup",
-            seq,
-        ],
+            &["stream"],
+            ports,
+            &["--camera", "/dev/null", "--setup", seq],
+        ]
+        .concat(),
         dir.path(),
     );
     assert!(!out.status.success());

@@ -12,6 +12,10 @@ use serialport::{SerialPort, TTYPort};
 
 use digiteyes_host::scenarios::{render_scenario, RenderOptions};
 
+/// `--port` twice, naming two boards that do not exist: for the refusals that must come
+/// before any port is opened.
+pub const TWO_ABSENT_BOARDS: [&str; 4] = ["--port", "/nonexistent/a", "--port", "/nonexistent/b"];
+
 /// The conformance fixture from an independent renderer.
 pub const FIXTURE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../fixtures/sample-mouse");
 
