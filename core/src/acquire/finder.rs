@@ -130,9 +130,10 @@ pub struct FinderConfig {
     /// state with its palm moved this share of its distance farther from and nearer to the
     /// first camera, with two or more cameras (`[0]`, default 0: not carried) and with one
     /// (`[1]`, default 0.08: 0.12 until stop 55, when 0.08 acquired 2,411 of 3,600 fresh
-    /// seeds against 2,385, 57 gained and 31 lost, with 3.8 % fewer wrong claimed frames, and
-    /// kept a variant at 1.1 m under the 100 mm that makes a frame far; `docs/recovery.md`,
-    /// "The depth share again"); a share outside (0, 1) carries none. A leaf's depth is guessed
+    /// seeds against 2,385, 57 gained and 31 lost, with 3.8 % fewer wrong claimed frames; on
+    /// seed 9657, 1.1 m away, its nearer variant led from the first frame where at 0.12 the
+    /// leaf, 125 mm beyond the hand, led for three; `docs/recovery.md`, "The depth share
+    /// again"); a share outside (0, 1) carries none. A leaf's depth is guessed
     /// from its size under a library finger pose, and one camera sees depth only through
     /// that size: the variant refined over the confirming frames scores above a leaf placed
     /// at the wrong depth. Not after a local re-acquisition, whose starts keep the depth the
