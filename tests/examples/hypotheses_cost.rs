@@ -1,9 +1,10 @@
 //! Tracks a rendered sequence with K hypotheses, for counting instructions per frame under
 //! callgrind (`scripts/hypotheses-instructions` collects only `MultiTracker::track`).
 //!
-//! `cargo run --release -p digiteyes-tests --example hypotheses_cost -- SEQ K FRAMES [EVERY [REVERSE]]`
+//! `cargo run --release -p digiteyes-tests --example hypotheses_cost -- SEQ K FRAMES [EVERY [REVERSE [KEEP]]]`
 //! (EVERY: `HypothesesConfig::score_every_frames`, default 1; REVERSE: the likelihood's
-//! `reverse_weight`, default the hypotheses' own).
+//! `reverse_weight`, default the hypotheses' own; KEEP: `keep_fingers`, 1 or 0, default the
+//! hypotheses' own).
 
 use anyhow::{Context, Result};
 use digiteyes_core::frame::FrameView;
@@ -23,10 +24,14 @@ fn main() -> Result<()> {
     let reverse: f32 = args
         .get(4)
         .map_or(Ok(defaults.likelihood.reverse_weight), |s| s.parse())?;
+    let keep_fingers = args.get(5).map_or(Ok(defaults.keep_fingers), |s| {
+        s.parse::<u8>().map(|v| v != 0)
+    })?;
     let sequence = Sequence::open(std::path::Path::new(seq))?;
     let config = HypothesesConfig {
         count: k,
         score_every_frames: every,
+        keep_fingers,
         likelihood: LikelihoodConfig {
             reverse_weight: reverse,
             ..defaults.likelihood

@@ -100,6 +100,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "tukey" => c.estimator.robust = Robust::Tukey(f),
             "s" => o.hypotheses.score_every_frames = f as u8,
             "spawn" => o.hypotheses.spawn_per_frame = f as u8,
+            "keepf" => o.hypotheses.keep_fingers = f != 0.0,
             "jumps" => o.hypotheses.jumps_per_frame = f as u8,
             "jturn" => o.hypotheses.jump_min_turn_rad = f,
             "jpx" => o.hypotheses.jump_max_moved_px = f,
