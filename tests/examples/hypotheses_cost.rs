@@ -24,9 +24,12 @@ fn main() -> Result<()> {
     let reverse: f32 = args
         .get(4)
         .map_or(Ok(defaults.likelihood.reverse_weight), |s| s.parse())?;
-    let keep_fingers = args.get(5).map_or(Ok(defaults.keep_fingers), |s| {
-        s.parse::<u8>().map(|v| v != 0)
-    })?;
+    let keep_fingers = match args.get(5).map(String::as_str) {
+        None => defaults.keep_fingers,
+        Some("1") => true,
+        Some("0") => false,
+        Some(other) => anyhow::bail!("KEEP is 1 or 0, not {other:?}"),
+    };
     let sequence = Sequence::open(std::path::Path::new(seq))?;
     let config = HypothesesConfig {
         count: k,
