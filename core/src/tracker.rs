@@ -290,6 +290,23 @@ impl Tracker {
         report
     }
 
+    /// [`Tracker::track`] with at most `iterations` Gauss–Newton iterations (0, or more than
+    /// the configured [`TrackerConfig::iterations`]: the configured number), which are back in
+    /// place afterwards, error or not.
+    pub fn track_at_most(
+        &mut self,
+        iterations: u8,
+        frames: &[FrameView<'_>],
+    ) -> Result<FrameReport, TrackerError> {
+        let own = self.config;
+        if iterations > 0 {
+            self.config.iterations = own.iterations.min(iterations);
+        }
+        let report = self.track(frames);
+        self.config = own;
+        report
+    }
+
     /// The prior toward the predicted state the frames to come are tracked under, in place
     /// of the configured one (which [`Tracker::config`] then shows). Weights that are not
     /// finite and non-negative are refused: `false`, and nothing changes.

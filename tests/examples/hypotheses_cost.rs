@@ -1,10 +1,11 @@
 //! Tracks a rendered sequence with K hypotheses, for counting instructions per frame under
 //! callgrind (`scripts/hypotheses-instructions` collects only `MultiTracker::track`).
 //!
-//! `cargo run --release -p digiteyes-tests --example hypotheses_cost -- SEQ K FRAMES [EVERY [REVERSE [KEEP]]]`
+//! `cargo run --release -p digiteyes-tests --example hypotheses_cost -- SEQ K FRAMES [EVERY [REVERSE [KEEP [SAMPLE_ITER [OTHER_ITER]]]]]`
 //! (EVERY: `HypothesesConfig::score_every_frames`, default 1; REVERSE: the likelihood's
 //! `reverse_weight`, default the hypotheses' own; KEEP: `keep_fingers`, 1 or 0, default the
-//! hypotheses' own).
+//! hypotheses' own; SAMPLE_ITER, OTHER_ITER: `sample_iterations` and `other_iterations`,
+//! default the hypotheses' own).
 
 use anyhow::{Context, Result};
 use digiteyes_core::frame::FrameView;
@@ -30,11 +31,19 @@ fn main() -> Result<()> {
         Some("0") => false,
         Some(other) => anyhow::bail!("KEEP is 1 or 0, not {other:?}"),
     };
+    let sample_iterations: u8 = args
+        .get(6)
+        .map_or(Ok(defaults.sample_iterations), |s| s.parse())?;
+    let other_iterations: u8 = args
+        .get(7)
+        .map_or(Ok(defaults.other_iterations), |s| s.parse())?;
     let sequence = Sequence::open(std::path::Path::new(seq))?;
     let config = HypothesesConfig {
         count: k,
         score_every_frames: every,
         keep_fingers,
+        sample_iterations,
+        other_iterations,
         likelihood: LikelihoodConfig {
             reverse_weight: reverse,
             ..defaults.likelihood

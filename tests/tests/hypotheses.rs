@@ -140,6 +140,76 @@ fn hypotheses_never_exceed_their_count_and_the_best_comes_first() {
     assert!(multi.track(&[view(&image)], &mut []).is_err());
 }
 
+/// `track_at_most` caps the Gauss–Newton iterations of one frame and puts the tracker's own
+/// number back; a cap of 0, or above the tracker's own, is `track` bit for bit.
+#[test]
+fn a_capped_frame_takes_at_most_its_iterations_and_the_own_number_returns() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = Sequence::open(&common::mouse(dir.path(), 6)).unwrap();
+    let mut plain = sequence_tracker(&seq);
+    let mut uncapped = sequence_tracker(&seq);
+    let mut capped = sequence_tracker(&seq);
+    let own = *capped.config();
+    let mut longest = 0;
+    for k in 0..seq.frames {
+        let image = seq.read_frame(0, k).unwrap();
+        let a = plain.track(&[view(&image)]).unwrap();
+        let b = uncapped
+            .track_at_most(if k % 2 == 0 { 0 } else { u8::MAX }, &[view(&image)])
+            .unwrap();
+        assert_eq!(a, b, "frame {k}");
+        assert_eq!(plain.memory(), uncapped.memory(), "frame {k}");
+        longest = longest.max(a.iterations);
+        let c = capped.track_at_most(1, &[view(&image)]).unwrap();
+        assert_eq!(c.iterations, 1, "frame {k}");
+        assert_eq!(*capped.config(), own, "frame {k}");
+    }
+    assert!(
+        longest > 1,
+        "the uncapped frames take more than one iteration"
+    );
+    // An error (a frame of the wrong size) puts the own number back too.
+    let small = vec![0u8; 16 * 16];
+    let wrong = FrameView::packed(&small, 16, 16).unwrap();
+    assert!(capped.track_at_most(1, &[wrong]).is_err());
+    assert_eq!(*capped.config(), own);
+}
+
+/// The carried hypotheses other than the best are tracked with at most `other_iterations`,
+/// the best with the tracker's own number.
+#[test]
+fn the_hypotheses_other_than_the_best_take_at_most_their_iterations() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = Sequence::open(&common::mouse(dir.path(), 13)).unwrap();
+    let config = HypothesesConfig {
+        count: 3,
+        spawn_per_frame: 2,
+        score_every_frames: 4,
+        other_iterations: 1,
+        sample_iterations: 1,
+        ..HypothesesConfig::default()
+    };
+    let mut bufs = buffers(&seq.cameras, &config);
+    let mut multi = MultiTracker::new(sequence_tracker(&seq), config);
+    let (mut others, mut best_longest) = (0, 0);
+    for k in 0..seq.frames {
+        let image = seq.read_frame(0, k).unwrap();
+        let mut slices: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
+        let report = multi.track(&[view(&image)], &mut slices).unwrap();
+        if report.sampled > 0 {
+            continue; // a scored frame: samples and carried hypotheses reorder
+        }
+        let h = multi.hypotheses();
+        best_longest = best_longest.max(h[0].report.iterations);
+        for other in &h[1..] {
+            assert!(other.report.iterations <= 1, "frame {k}");
+            others += 1;
+        }
+    }
+    assert!(others > 0, "no hypothesis but the best was carried");
+    assert!(best_longest > 1, "the best takes the tracker's own number");
+}
+
 /// Scored one frame in S: on the frames between, every hypothesis is tracked in its rank
 /// with its last score and nothing is sampled or merged; the first frame, every S-th, and
 /// every frame after one whose best was flagged lost are scored.

@@ -64,6 +64,14 @@ pub struct HypothesesConfig {
     /// it was on the last frame), and with every finger's undone: a finger the slices pulled
     /// onto a neighbour's edges scores worse than where it was.
     pub keep_fingers: bool,
+    /// Gauss–Newton iterations at most for each sample on the frame it is drawn (0: the
+    /// tracker's own). Default 0: at 2 (with [`HypothesesConfig::other_iterations`]) K = 4
+    /// costs a third less a frame and, on fresh seeds, gives back part of its gain
+    /// (`docs/hypotheses.md`, "Fewer iterations for the hypotheses other than the best").
+    pub sample_iterations: u8,
+    /// Gauss–Newton iterations at most for each carried hypothesis other than the best (0:
+    /// the tracker's own). The best always takes the tracker's own number.
+    pub other_iterations: u8,
     /// Units of the state kinds.
     pub spread: Spread,
     /// How far a sample lies from the best along a weak direction (in [`Spread`] units).
@@ -138,6 +146,8 @@ impl Default for HypothesesConfig {
             jump_min_turn_rad: 0.3,
             jump_max_moved_px: 4.0,
             keep_fingers: true,
+            sample_iterations: 0,
+            other_iterations: 0,
             spread: Spread::default(),
             spawn_step: 1.0,
             merge_distance: 0.3,

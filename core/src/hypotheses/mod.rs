@@ -260,7 +260,12 @@ impl MultiTracker {
         // 1. Every hypothesis through the loop; the weak directions of the best.
         for (index, h) in self.hypotheses.iter().enumerate() {
             self.tracker.restore(&h.memory)?;
-            let report = self.tracker.track(frames)?;
+            let cap = if index == 0 {
+                0
+            } else {
+                self.config.other_iterations
+            };
+            let report = self.tracker.track_at_most(cap, frames)?;
             let memory = self.tracker.memory();
             if index == 0 {
                 let spawn = self.config.spawn();
@@ -361,7 +366,9 @@ impl MultiTracker {
             if self.tracker.restore(sample).is_err() {
                 continue;
             }
-            let report = self.tracker.track(frames)?;
+            let report = self
+                .tracker
+                .track_at_most(self.config.sample_iterations, frames)?;
             let mut memory = self.tracker.memory();
             memory.velocity = parent_velocity;
             sampled += 1;
@@ -453,9 +460,14 @@ impl MultiTracker {
         if self.hypotheses.is_empty() {
             self.adopt();
         }
-        for h in self.hypotheses.iter_mut() {
+        for (index, h) in self.hypotheses.iter_mut().enumerate() {
             self.tracker.restore(&h.memory)?;
-            h.report = self.tracker.track(frames)?;
+            let cap = if index == 0 {
+                0
+            } else {
+                self.config.other_iterations
+            };
+            h.report = self.tracker.track_at_most(cap, frames)?;
             h.memory = self.tracker.memory();
             h.age += 1;
         }
