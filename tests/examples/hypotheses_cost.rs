@@ -33,10 +33,12 @@ fn main() -> Result<()> {
     };
     let sample_iterations: u8 = args
         .get(6)
-        .map_or(Ok(defaults.sample_iterations), |s| s.parse())?;
+        .map_or(Ok(defaults.sample_iterations), |s| s.parse())
+        .context("SAMPLE_ITER is a whole number of iterations, 0 to 255")?;
     let other_iterations: u8 = args
         .get(7)
-        .map_or(Ok(defaults.other_iterations), |s| s.parse())?;
+        .map_or(Ok(defaults.other_iterations), |s| s.parse())
+        .context("OTHER_ITER is a whole number of iterations, 0 to 255")?;
     let sequence = Sequence::open(std::path::Path::new(seq))?;
     let config = HypothesesConfig {
         count: k,
