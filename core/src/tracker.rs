@@ -298,12 +298,13 @@ impl Tracker {
         iterations: u8,
         frames: &[FrameView<'_>],
     ) -> Result<FrameReport, TrackerError> {
-        let own = self.config;
-        if iterations > 0 {
-            self.config.iterations = own.iterations.min(iterations);
+        let own = self.config.iterations;
+        if iterations == 0 || iterations >= own {
+            return self.track(frames);
         }
+        self.config.iterations = iterations;
         let report = self.track(frames);
-        self.config = own;
+        self.config.iterations = own;
         report
     }
 

@@ -127,6 +127,17 @@ impl HypothesesConfig {
         }
     }
 
+    /// The cap on the Gauss–Newton iterations of the carried hypothesis of rank `rank` (0 is
+    /// the best, never capped): [`HypothesesConfig::other_iterations`] for the others, 0 for
+    /// the tracker's own number.
+    pub fn carried_iterations(&self, rank: usize) -> u8 {
+        if rank == 0 {
+            0
+        } else {
+            self.other_iterations
+        }
+    }
+
     /// `jumps_per_frame` clamped to [`MAX_JUMPS`], and to 0 for a single hypothesis.
     pub fn jumps(&self) -> usize {
         if self.count() == 1 {

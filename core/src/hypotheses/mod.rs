@@ -260,11 +260,7 @@ impl MultiTracker {
         // 1. Every hypothesis through the loop; the weak directions of the best.
         for (index, h) in self.hypotheses.iter().enumerate() {
             self.tracker.restore(&h.memory)?;
-            let cap = if index == 0 {
-                0
-            } else {
-                self.config.other_iterations
-            };
+            let cap = self.config.carried_iterations(index);
             let report = self.tracker.track_at_most(cap, frames)?;
             let memory = self.tracker.memory();
             if index == 0 {
@@ -462,11 +458,7 @@ impl MultiTracker {
         }
         for (index, h) in self.hypotheses.iter_mut().enumerate() {
             self.tracker.restore(&h.memory)?;
-            let cap = if index == 0 {
-                0
-            } else {
-                self.config.other_iterations
-            };
+            let cap = self.config.carried_iterations(index);
             h.report = self.tracker.track_at_most(cap, frames)?;
             h.memory = self.tracker.memory();
             h.age += 1;
