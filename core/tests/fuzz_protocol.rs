@@ -50,7 +50,7 @@ enum Owned {
     Ping(u32),
     Chunk(u32, u16, u16, u32, Vec<u8>),
     Reset(Vec<f32>, u32, bool),
-    Configure(u16, u8, u8),
+    Configure(u16, u8, u8, [u8; 2]),
 }
 
 impl Owned {
@@ -71,21 +71,25 @@ impl Owned {
                 free: *free,
                 start: if *search { Start::Search } else { Start::Given },
             }),
-            Owned::Configure(budget, hypotheses, every) => HostMessage::Configure(Configure {
-                camera: CameraParams {
-                    width: 320,
-                    height: 240,
-                    intrinsics: [500.0, 500.0, 159.5, 119.5],
-                    r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
-                    t: [0.0, 0.0, 600.0],
-                },
-                tracker: TrackerParams::default(),
-                features_every: 0,
-                stats_every: 0,
-                search_evaluations_per_frame: *budget,
-                hypotheses: *hypotheses,
-                hypotheses_score_every: *every,
-            }),
+            Owned::Configure(budget, hypotheses, every, caps) => {
+                HostMessage::Configure(Configure {
+                    camera: CameraParams {
+                        width: 320,
+                        height: 240,
+                        intrinsics: [500.0, 500.0, 159.5, 119.5],
+                        r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+                        t: [0.0, 0.0, 600.0],
+                    },
+                    tracker: TrackerParams::default(),
+                    features_every: 0,
+                    stats_every: 0,
+                    search_evaluations_per_frame: *budget,
+                    hypotheses: *hypotheses,
+                    hypotheses_score_every: *every,
+                    hypotheses_sample_iterations: caps[0],
+                    hypotheses_other_iterations: caps[1],
+                })
+            }
         }
     }
 }
@@ -107,7 +111,8 @@ fn owned() -> impl Strategy<Value = Owned> {
             any::<bool>()
         )
             .prop_map(|(q, free, search)| Owned::Reset(q, free, search)),
-        (any::<u16>(), any::<u8>(), any::<u8>()).prop_map(|(b, k, s)| Owned::Configure(b, k, s)),
+        (any::<u16>(), any::<u8>(), any::<u8>(), any::<[u8; 2]>())
+            .prop_map(|(b, k, s, caps)| Owned::Configure(b, k, s, caps)),
     ]
 }
 

@@ -175,6 +175,8 @@ fn host_messages(data: &[u8]) -> std::vec::Vec<HostMessage<'_>> {
             search_evaluations_per_frame: u16::MAX,
             hypotheses: u8::MAX,
             hypotheses_score_every: u8::MAX,
+            hypotheses_sample_iterations: u8::MAX,
+            hypotheses_other_iterations: u8::MAX,
         }),
         HostMessage::FrameChunk(FrameChunk {
             frame: u32::MAX,

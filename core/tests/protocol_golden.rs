@@ -43,6 +43,8 @@ fn host_messages(data: &[u8]) -> Vec<(&'static str, HostMessage<'_>)> {
                 search_evaluations_per_frame: 1000,
                 hypotheses: 4,
                 hypotheses_score_every: 3,
+                hypotheses_sample_iterations: 2,
+                hypotheses_other_iterations: 1,
             }),
         ),
         (
@@ -290,7 +292,8 @@ fn golden_host(name: &str) -> &'static [u8] {
             0x44, 0x08, 0x01, 0x05, 0x14, 0x01, 0x05, 0x80, 0x40, 0x02, 0x01, 0x01, 0x01, 0x02,
             0x40, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x07, 0x7a, 0x44, 0x9a,
             0x99, 0x99, 0x3e, 0x01, 0x08, 0xc0, 0x40, 0x01, 0x92, 0x0a, 0x06, 0x3f, 0x01, 0x01,
-            0x02, 0x3f, 0x0a, 0x1e, 0xe8, 0x07, 0x04, 0x03, 0x15, 0x8a, 0x64, 0x84, 0x00,
+            0x02, 0x3f, 0x0c, 0x1e, 0xe8, 0x07, 0x04, 0x03, 0x02, 0x01, 0xa5, 0x48, 0x30, 0x3e,
+            0x00,
         ],
         "FrameChunk" => &[
             0x00, 0x05, 0x02, 0x07, 0x04, 0x02, 0x05, 0x08, 0x01, 0x02, 0x03, 0x09, 0xff, 0x04,
@@ -470,8 +473,26 @@ fn an_older_configure_is_a_decode_error(old: &[u8], grown: usize, why: &str) {
     assert_eq!(frame.len(), old.len() + grown, "{why}");
 }
 
+/// Version 9's `Configure` (no caps on the hypotheses' iterations), as a version 9 host sends
+/// it: a version 10 board counts it as a decode error and answers nothing.
+#[test]
+fn version_9_configure_is_a_decode_error() {
+    const V9_CONFIGURE: &[u8] = &[
+        0x00, 0x06, 0x01, 0xc0, 0x02, 0xf0, 0x01, 0x01, 0x03, 0xfa, 0x43, 0x01, 0x03, 0xfa, 0x43,
+        0x04, 0x80, 0x1f, 0x43, 0x01, 0x03, 0xef, 0x42, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x01, 0x01,
+        0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x01,
+        0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x03, 0x80, 0x3f, 0x01,
+        0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x07, 0x16, 0x44, 0x08, 0x01, 0x05, 0x14,
+        0x01, 0x05, 0x80, 0x40, 0x02, 0x01, 0x01, 0x01, 0x02, 0x40, 0x01, 0x03, 0x80, 0x3f, 0x01,
+        0x03, 0x80, 0x3f, 0x01, 0x07, 0x7a, 0x44, 0x9a, 0x99, 0x99, 0x3e, 0x01, 0x08, 0xc0, 0x40,
+        0x01, 0x92, 0x0a, 0x06, 0x3f, 0x01, 0x01, 0x02, 0x3f, 0x0a, 0x1e, 0xe8, 0x07, 0x04, 0x03,
+        0x15, 0x8a, 0x64, 0x84, 0x00,
+    ];
+    an_older_configure_is_a_decode_error(V9_CONFIGURE, 2, "two bytes more: the two caps");
+}
+
 /// Version 8's `Configure` (no `hypotheses_score_every`), as a version 8 host sends it: a
-/// version 9 board counts it as a decode error and answers nothing.
+/// version 9 or 10 board counts it as a decode error and answers nothing.
 #[test]
 fn version_8_configure_is_a_decode_error() {
     const V8_CONFIGURE: &[u8] = &[
@@ -485,11 +506,15 @@ fn version_8_configure_is_a_decode_error() {
         0x01, 0x92, 0x0a, 0x06, 0x3f, 0x01, 0x01, 0x02, 0x3f, 0x09, 0x1e, 0xe8, 0x07, 0x04, 0x36,
         0xbb, 0xa1, 0xd5, 0x00,
     ];
-    an_older_configure_is_a_decode_error(V8_CONFIGURE, 1, "one byte more: the score-every count");
+    an_older_configure_is_a_decode_error(
+        V8_CONFIGURE,
+        1 + 2,
+        "one byte more for the score-every count, two for version 10's caps",
+    );
 }
 
 /// Version 7's `Configure` (no `outermost_share` in its tracker parameters), as a version 7
-/// host sends it: a version 8 or 9 board counts it as a decode error and answers nothing.
+/// host sends it: a version 8 to 10 board counts it as a decode error and answers nothing.
 #[test]
 fn version_7_configure_is_a_decode_error() {
     const V7_CONFIGURE: &[u8] = &[
@@ -504,13 +529,14 @@ fn version_7_configure_is_a_decode_error() {
     ];
     an_older_configure_is_a_decode_error(
         V7_CONFIGURE,
-        4 + 1,
-        "four bytes more for the share's f32, one for version 9's score-every count",
+        4 + 1 + 2,
+        "four bytes more for the share's f32, one for version 9's score-every count, two for \
+         version 10's caps",
     );
 }
 
 /// Version 6's `Configure` (no `max_edge_angle_rad` in its tracker parameters), as a version 6
-/// host sends it: a version 7 to 9 board counts it as a decode error and answers nothing.
+/// host sends it: a version 7 to 10 board counts it as a decode error and answers nothing.
 #[test]
 fn version_6_configure_is_a_decode_error() {
     const V6_CONFIGURE: &[u8] = &[
@@ -525,14 +551,14 @@ fn version_6_configure_is_a_decode_error() {
     ];
     an_older_configure_is_a_decode_error(
         V6_CONFIGURE,
-        4 + 4 + 1,
+        4 + 4 + 1 + 2,
         "four bytes more for the angle's f32, four for version 8's share, one for version 9's \
-         count",
+         count, two for version 10's caps",
     );
 }
 
 /// Version 5's `Configure` (no `palm_edges` in its tracker parameters), as a version 5 host
-/// sends it: a version 6 to 9 board counts it as a decode error and answers nothing.
+/// sends it: a version 6 to 10 board counts it as a decode error and answers nothing.
 #[test]
 fn version_5_configure_is_a_decode_error() {
     const V5_CONFIGURE: &[u8] = &[
@@ -547,9 +573,9 @@ fn version_5_configure_is_a_decode_error() {
     ];
     an_older_configure_is_a_decode_error(
         V5_CONFIGURE,
-        1 + 4 + 4 + 1,
+        1 + 4 + 4 + 1 + 2,
         "one byte more for the flag, four for version 7's angle, four for version 8's share, \
-         one for version 9's count",
+         one for version 9's count, two for version 10's caps",
     );
 }
 
@@ -570,9 +596,9 @@ fn version_4_configure_is_a_decode_error() {
     ];
     an_older_configure_is_a_decode_error(
         V4_CONFIGURE,
-        2 + 4 + 4 + 1,
-        "the count, version 6's palm flag, version 7's angle, version 8's share and version \
-         9's score-every count",
+        2 + 4 + 4 + 1 + 2,
+        "the count, version 6's palm flag, version 7's angle, version 8's share, version \
+         9's score-every count and version 10's caps",
     );
 }
 

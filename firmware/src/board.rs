@@ -337,7 +337,7 @@ where
             return Err(Refusal::BadParameters);
         }
         let acquire = search_config(configure.search_evaluations_per_frame);
-        let hypotheses = hypotheses_config(configure.hypotheses, configure.hypotheses_score_every);
+        let hypotheses = hypotheses_config(configure);
         if configure.camera.frame_bytes() > self.frame.len()
             || AutoTracker::edge_bytes_needed(&camera, &acquire) > self.edge_map.len()
         {

@@ -11,6 +11,7 @@
 use digiteyes_core::acquire::AcquireConfig;
 use digiteyes_core::hypotheses::HypothesesConfig;
 use digiteyes_core::likelihood::{LikelihoodConfig, EDGE_BINS};
+use digiteyes_core::protocol::Configure;
 
 /// Side of an edge-map cell (px) on a board: the search's default (4 keeps a VGA frame's map
 /// at 115,200 bytes).
@@ -36,15 +37,17 @@ pub fn search_config(evaluations_per_frame: u16) -> AcquireConfig {
     }
 }
 
-/// The hypotheses a board tracks: the tracker's defaults, `count` of them (`Configure`'s
-/// `hypotheses`), scored one frame in `score_every_frames` (its `hypotheses_score_every`),
-/// their likelihood's edge map at [`SEARCH_STRIDE_PX`] so it fits the
-/// search's buffer ([`Buffers::edge_map`]).
-pub fn hypotheses_config(count: u8, score_every_frames: u8) -> HypothesesConfig {
+/// The hypotheses a board tracks: the tracker's defaults, as many as `Configure`'s
+/// `hypotheses`, scored one frame in its `hypotheses_score_every`, their iterations capped by
+/// its `hypotheses_sample_iterations` and `hypotheses_other_iterations`, their likelihood's
+/// edge map at [`SEARCH_STRIDE_PX`] so it fits the search's buffer ([`Buffers::edge_map`]).
+pub fn hypotheses_config(configure: &Configure) -> HypothesesConfig {
     let defaults = HypothesesConfig::default();
     HypothesesConfig {
-        count,
-        score_every_frames,
+        count: configure.hypotheses,
+        score_every_frames: configure.hypotheses_score_every,
+        sample_iterations: configure.hypotheses_sample_iterations,
+        other_iterations: configure.hypotheses_other_iterations,
         likelihood: LikelihoodConfig {
             stride_px: SEARCH_STRIDE_PX,
             ..defaults.likelihood
@@ -70,6 +73,29 @@ pub struct Buffers<'m> {
 mod tests {
     use super::*;
     use digiteyes_core::likelihood::EdgeMap;
+    use digiteyes_core::protocol::{CameraParams, TrackerParams};
+
+    /// A `Configure` asking for `count` hypotheses scored one frame in `score_every`, their
+    /// iterations capped at `[sample, other]`.
+    fn configure(count: u8, score_every: u8, iterations: [u8; 2]) -> Configure {
+        Configure {
+            camera: CameraParams {
+                width: 320,
+                height: 240,
+                intrinsics: [400.0, 400.0, 160.0, 120.0],
+                r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+                t: [0.0, 0.0, 500.0],
+            },
+            tracker: TrackerParams::default(),
+            features_every: 0,
+            stats_every: 0,
+            search_evaluations_per_frame: 100,
+            hypotheses: count,
+            hypotheses_score_every: score_every,
+            hypotheses_sample_iterations: iterations[0],
+            hypotheses_other_iterations: iterations[1],
+        }
+    }
 
     #[test]
     fn edge_map_bytes_is_what_the_search_asks_for() {
@@ -88,8 +114,10 @@ mod tests {
     #[test]
     fn the_hypotheses_edge_map_fits_the_search_buffer() {
         for k in 1..=8u8 {
-            let config = hypotheses_config(k, 1);
+            let config = hypotheses_config(&configure(k, 3, [2, 1]));
             assert_eq!(config.count, k);
+            assert_eq!(config.score_every_frames, 3);
+            assert_eq!((config.sample_iterations, config.other_iterations), (2, 1));
             assert_eq!(config.likelihood.stride_px, SEARCH_STRIDE_PX);
             for (w, h) in [(640, 480), (320, 240), (161, 119)] {
                 assert_eq!(

@@ -30,6 +30,8 @@ fn configure(stats_every: u16, features_every: u16) -> HostMessage<'static> {
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses: 1,
         hypotheses_score_every: 1,
+        hypotheses_sample_iterations: 0,
+        hypotheses_other_iterations: 0,
     })
 }
 
@@ -354,6 +356,8 @@ fn bad_commands_are_refused_and_change_nothing() {
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses: 1,
         hypotheses_score_every: 1,
+        hypotheses_sample_iterations: 0,
+        hypotheses_other_iterations: 0,
     }));
     params.iterations = 0;
     pipe.send(&HostMessage::Configure(Configure {
@@ -364,6 +368,8 @@ fn bad_commands_are_refused_and_change_nothing() {
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses: 1,
         hypotheses_score_every: 1,
+        hypotheses_sample_iterations: 0,
+        hypotheses_other_iterations: 0,
     }));
     let mut big = good_cam;
     big.width *= 2;
@@ -375,6 +381,8 @@ fn bad_commands_are_refused_and_change_nothing() {
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses: 1,
         hypotheses_score_every: 1,
+        hypotheses_sample_iterations: 0,
+        hypotheses_other_iterations: 0,
     }));
     pipe.send(&configure(0, 0));
     pipe.send(&HostMessage::Reset(Reset {

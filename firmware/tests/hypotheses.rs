@@ -25,8 +25,10 @@ fn free_all(model: &Model) -> u32 {
     (0..model.n_states()).map(|s| 1u32 << s).sum()
 }
 
-fn configure(hypotheses: u8, score_every: u8) -> HostMessage<'static> {
-    HostMessage::Configure(Configure {
+/// `Configure` with `hypotheses` scored one frame in `score_every`, their Gauss–Newton
+/// iterations capped at `caps` = `[sample, other]` (0: the tracker's own).
+fn configure_capped(hypotheses: u8, score_every: u8, caps: [u8; 2]) -> Configure {
+    Configure {
         camera: CameraParams::from_camera(&camera()).unwrap(),
         tracker: TrackerParams::default(),
         features_every: 0,
@@ -34,15 +36,20 @@ fn configure(hypotheses: u8, score_every: u8) -> HostMessage<'static> {
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses,
         hypotheses_score_every: score_every,
-    })
+        hypotheses_sample_iterations: caps[0],
+        hypotheses_other_iterations: caps[1],
+    }
 }
 
-/// A board after boot, `Configure` with `k` hypotheses scored one frame in `s`, and `Reset`
-/// tracking from `q0`.
-fn started<'m>(buffer: &'m mut [u8], k: u8, s: u8, q0: &[f32], free: u32) -> TestBoard<'m> {
+fn configure(hypotheses: u8, score_every: u8) -> HostMessage<'static> {
+    HostMessage::Configure(configure_capped(hypotheses, score_every, [0, 0]))
+}
+
+/// A board after boot, `Configure`d as `wanted`, and `Reset` tracking from `q0`.
+fn started<'m>(buffer: &'m mut [u8], wanted: Configure, q0: &[f32], free: u32) -> TestBoard<'m> {
     let mut board = test_board("hypotheses", buffer);
     board.start().unwrap();
-    board.serial_mut().send(&configure(k, s));
+    board.serial_mut().send(&HostMessage::Configure(wanted));
     board.serial_mut().send(&HostMessage::Reset(Reset {
         q: q0.iter().copied().collect(),
         free,
@@ -77,16 +84,17 @@ fn sequence(model: &Model) -> Vec<Vec<u8>> {
         .collect()
 }
 
-/// The board with `k` hypotheses scored one frame in `s` against `AutoTracker` in process
-/// with the same `k` and `s`: every frame's `State` (state, status, report) and `Hypotheses`
-/// (scores, ages, states, best first) bit-equal. Returns the most hypotheses any frame
-/// carried.
-fn board_matches_in_process(k: u8, s: u8) -> usize {
+/// The board with `k` hypotheses scored one frame in `s`, their iterations capped at `caps`,
+/// against `AutoTracker` in process with the same: every frame's `State` (state, status,
+/// report) and `Hypotheses` (scores, ages, states, best first) bit-equal. Returns the most
+/// hypotheses any frame carried.
+fn board_matches_in_process(k: u8, s: u8, caps: [u8; 2]) -> usize {
     let model = Model::hand().unwrap();
     let q0 = pose(&model, 0.2);
     let free = free_all(&model);
     let mut buffer = vec![0u8; FRAME_BYTES];
-    let mut board = started(&mut buffer, k, s, &q0, free);
+    let wanted = configure_capped(k, s, caps);
+    let mut board = started(&mut buffer, wanted, &q0, free);
     let tracker = TrackerParams::default().to_config().unwrap();
     let mut reference = AutoTracker::tracking(
         model.clone(),
@@ -97,7 +105,7 @@ fn board_matches_in_process(k: u8, s: u8) -> usize {
         search_config(default_search_evaluations()),
     )
     .unwrap();
-    reference.set_hypotheses(hypotheses_config(k, s));
+    reference.set_hypotheses(hypotheses_config(&wanted));
     let mut edges = vec![0u8; edge_map_bytes(WIDTH as usize, HEIGHT as usize)];
     let mut most = 0;
     for (n, pixels) in sequence(&model).iter().enumerate() {
@@ -160,41 +168,44 @@ fn board_matches_in_process(k: u8, s: u8) -> usize {
 
 #[test]
 fn a_board_with_two_hypotheses_is_bit_equal_to_the_tracker_in_process() {
-    let most = board_matches_in_process(2, 1);
+    let most = board_matches_in_process(2, 1, [0, 0]);
     assert_eq!(most, 2, "two hypotheses were carried on some frame");
 }
 
 #[test]
 fn a_board_scoring_one_frame_in_three_is_bit_equal_to_the_tracker_in_process() {
-    let most = board_matches_in_process(2, 3);
+    let most = board_matches_in_process(2, 3, [0, 0]);
     assert_eq!(most, 2, "two hypotheses were carried on some frame");
+}
+
+/// Every hypothesis message a board `Configure`d as `wanted` sends over the test sequence,
+/// as bits.
+fn carried(wanted: Configure) -> Vec<Vec<(u32, u32, Vec<u32>)>> {
+    let model = Model::hand().unwrap();
+    let q0 = pose(&model, 0.2);
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = started(&mut buffer, wanted, &q0, free_all(&model));
+    let mut all = Vec::new();
+    for (n, pixels) in sequence(&model).iter().enumerate() {
+        board
+            .serial_mut()
+            .send_frame(n as u32, WIDTH as u16, HEIGHT as u16, pixels);
+        board.poll().unwrap();
+        for message in board.serial_mut().received() {
+            if let BoardMessage::Hypotheses(h) = message {
+                all.push(h.hypotheses.iter().map(hypothesis_bits).collect::<Vec<_>>());
+            }
+        }
+    }
+    all
 }
 
 /// Scored one frame in S, the hypotheses differ from those scored every frame: S reaches
 /// the board's tracker (the bit-equal test above would pass if both sides ignored it).
 #[test]
 fn scoring_one_frame_in_three_changes_what_the_board_carries() {
-    let model = Model::hand().unwrap();
-    let q0 = pose(&model, 0.2);
-    let free = free_all(&model);
-    let carried = |s: u8| {
-        let mut buffer = vec![0u8; FRAME_BYTES];
-        let mut board = started(&mut buffer, 2, s, &q0, free);
-        let mut all = Vec::new();
-        for (n, pixels) in sequence(&model).iter().enumerate() {
-            board
-                .serial_mut()
-                .send_frame(n as u32, WIDTH as u16, HEIGHT as u16, pixels);
-            board.poll().unwrap();
-            for message in board.serial_mut().received() {
-                if let BoardMessage::Hypotheses(h) = message {
-                    all.push(h.hypotheses.iter().map(hypothesis_bits).collect::<Vec<_>>());
-                }
-            }
-        }
-        all
-    };
-    let (every, one_in_three) = (carried(1), carried(3));
+    let every = carried(configure_capped(2, 1, [0, 0]));
+    let one_in_three = carried(configure_capped(2, 3, [0, 0]));
     assert_eq!(every.len(), one_in_three.len());
     assert_eq!(
         every[0], one_in_three[0],
@@ -203,9 +214,31 @@ fn scoring_one_frame_in_three_changes_what_the_board_carries() {
     assert_ne!(every, one_in_three);
 }
 
+/// Capped at one iteration, the samples and the carried hypotheses other than the best
+/// differ from those refined uncapped: both caps reach the board's tracker (the bit-equal
+/// test above would pass if both sides ignored them).
+#[test]
+fn capping_the_hypotheses_iterations_changes_what_the_board_carries() {
+    let own = carried(configure_capped(2, 1, [0, 0]));
+    let samples_capped = carried(configure_capped(2, 1, [1, 0]));
+    let others_capped = carried(configure_capped(2, 1, [0, 1]));
+    assert_eq!(own.len(), samples_capped.len());
+    assert_ne!(own, samples_capped, "the sample cap changed nothing");
+    assert_ne!(own, others_capped, "the cap on the others changed nothing");
+    // A cap at or above the tracker's own number is no cap.
+    let own_iterations = TrackerParams::default().iterations;
+    assert_eq!(own, carried(configure_capped(2, 1, [own_iterations; 2])));
+}
+
 #[test]
 fn a_board_with_four_hypotheses_is_bit_equal_to_the_tracker_in_process() {
-    let most = board_matches_in_process(4, 1);
+    let most = board_matches_in_process(4, 1, [0, 0]);
+    assert!(most >= 2, "several hypotheses were carried: at most {most}");
+}
+
+#[test]
+fn a_board_with_capped_iterations_is_bit_equal_to_the_tracker_in_process() {
+    let most = board_matches_in_process(4, 1, [1, 1]);
     assert!(most >= 2, "several hypotheses were carried: at most {most}");
 }
 
@@ -214,7 +247,12 @@ fn one_hypothesis_sends_no_hypotheses_message() {
     let model = Model::hand().unwrap();
     let q0 = pose(&model, 0.2);
     let mut buffer = vec![0u8; FRAME_BYTES];
-    let mut board = started(&mut buffer, 1, 1, &q0, free_all(&model));
+    let mut board = started(
+        &mut buffer,
+        configure_capped(1, 1, [0, 0]),
+        &q0,
+        free_all(&model),
+    );
     let pixels = render(&model, &camera(), &pose(&model, 0.22));
     board
         .serial_mut()
@@ -280,7 +318,12 @@ fn a_configure_changing_only_the_count_applies_it_from_the_next_frame() {
     let model = Model::hand().unwrap();
     let q0 = pose(&model, 0.2);
     let mut buffer = vec![0u8; FRAME_BYTES];
-    let mut board = started(&mut buffer, 1, 1, &q0, free_all(&model));
+    let mut board = started(
+        &mut buffer,
+        configure_capped(1, 1, [0, 0]),
+        &q0,
+        free_all(&model),
+    );
     let frames = sequence(&model);
     let mut kinds = Vec::new();
     for (n, (pixels, k)) in frames.iter().zip([1u8, 3, 3, 1]).enumerate() {

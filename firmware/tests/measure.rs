@@ -35,6 +35,8 @@ fn configure() -> HostMessage<'static> {
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses: 1,
         hypotheses_score_every: 1,
+        hypotheses_sample_iterations: 0,
+        hypotheses_other_iterations: 0,
     })
 }
 

@@ -40,6 +40,8 @@ fn configure(iterations: u8, budget: u16) -> HostMessage<'static> {
         search_evaluations_per_frame: budget,
         hypotheses: 1,
         hypotheses_score_every: 1,
+        hypotheses_sample_iterations: 0,
+        hypotheses_other_iterations: 0,
     })
 }
 

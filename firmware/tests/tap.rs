@@ -46,6 +46,8 @@ fn the_tap_sees_every_frame_of_a_pass_with_its_pixels_and_state() {
         search_evaluations_per_frame: default_search_evaluations(),
         hypotheses: 1,
         hypotheses_score_every: 1,
+        hypotheses_sample_iterations: 0,
+        hypotheses_other_iterations: 0,
     }));
     board.serial_mut().send(&HostMessage::Reset(Reset {
         q: q0.iter().copied().collect(),

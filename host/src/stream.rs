@@ -18,8 +18,8 @@ use std::time::Duration;
 
 use anyhow::{anyhow, ensure, Context, Result};
 use digiteyes_core::protocol::{
-    default_hypotheses, default_hypotheses_score_every, default_search_evaluations, Start, State,
-    TrackerParams,
+    default_hypotheses, default_hypotheses_iterations, default_hypotheses_score_every,
+    default_search_evaluations, Start, State, TrackerParams,
 };
 use digiteyes_core::status::Status;
 use digiteyes_core::tracker::FrameReport;
@@ -68,6 +68,12 @@ pub struct StreamOptions {
     pub hypotheses: u8,
     /// The hypotheses are scored one frame in this many (`Configure`, at least 1).
     pub hypotheses_score_every: u8,
+    /// Gauss–Newton iterations at most for each new sample (`Configure`; 0: the tracker's
+    /// own).
+    pub hypotheses_sample_iterations: u8,
+    /// Gauss–Newton iterations at most for each carried hypothesis other than the best
+    /// (`Configure`; 0: the tracker's own).
+    pub hypotheses_other_iterations: u8,
     /// Show a progress bar (when stderr is a terminal).
     pub progress: bool,
 }
@@ -85,6 +91,8 @@ impl StreamOptions {
             search_evaluations_per_frame: default_search_evaluations(),
             hypotheses: default_hypotheses(),
             hypotheses_score_every: default_hypotheses_score_every(),
+            hypotheses_sample_iterations: default_hypotheses_iterations()[0],
+            hypotheses_other_iterations: default_hypotheses_iterations()[1],
             progress: false,
         }
     }
@@ -362,6 +370,8 @@ fn connect(sequence: &Sequence, options: &StreamOptions) -> Result<Session> {
     setup.search_evaluations_per_frame = options.search_evaluations_per_frame;
     setup.hypotheses = options.hypotheses;
     setup.hypotheses_score_every = options.hypotheses_score_every;
+    setup.hypotheses_sample_iterations = options.hypotheses_sample_iterations;
+    setup.hypotheses_other_iterations = options.hypotheses_other_iterations;
     setup.reply_timeout = options.reply_timeout;
     let link = Link::open(&options.port, options.baud)?;
     Session::start(link, setup)

@@ -2,8 +2,9 @@
 //! `stream --hypotheses K` has a simulated board (the firmware's loop) carry K hypotheses and
 //! the summary count the `Hypotheses` messages that follow its states; `listen` prints each
 //! one and counts them; a count out of 1..=8, or with one board per camera, is refused clearly;
-//! `--score-every S` (protocol version 9) reaches the board, and is refused where it means
-//! nothing.
+//! `--score-every S` (protocol version 9) and the caps on the hypotheses' iterations
+//! (`--sample-iterations`, `--other-iterations`, protocol version 10) reach the board, and are
+//! refused where they mean nothing.
 
 mod common;
 
@@ -18,7 +19,7 @@ use digiteyes_host::sim::{self, SimOptions};
 #[test]
 fn stream_with_hypotheses_counts_what_the_board_carried() {
     let dir = tempfile::tempdir().unwrap();
-    let frames = 4;
+    let frames = 8;
     common::small_sequence(dir.path(), "fullhand-mono", frames);
     let run = |extra: &[&str], csv: &str| {
         let board = sim::start(SimOptions::default()).unwrap();
@@ -68,11 +69,49 @@ fn stream_with_hypotheses_counts_what_the_board_carried() {
         every_other.contains(&format!("hypotheses: {frames} messages")),
         "{every_other}"
     );
-    let read = |csv: &str| std::fs::read_to_string(dir.path().join(csv)).unwrap();
+    // What the board estimated, without its `board_ticks` (its time, which differs from run to
+    // run): two runs alike compare equal.
+    let read = |csv: &str| -> Vec<String> {
+        let text = std::fs::read_to_string(dir.path().join(csv)).unwrap();
+        let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+        let ticks = header.iter().position(|c| *c == "board_ticks").unwrap();
+        text.lines()
+            .map(|line| {
+                let mut cells: Vec<&str> = line.split(',').collect();
+                cells.remove(ticks);
+                cells.join(",")
+            })
+            .collect()
+    };
+    run(&["--hypotheses", "3"], "k3-again.csv");
+    assert_eq!(read("k3.csv"), read("k3-again.csv"), "the same run twice");
     assert_ne!(
         read("k3.csv"),
         read("k3s2.csv"),
         "--score-every 2 changed nothing"
+    );
+
+    // With the iterations of the samples and of the hypotheses other than the best capped at
+    // one (protocol version 10), the board carries other hypotheses than uncapped.
+    let capped = run(
+        &[
+            "--hypotheses",
+            "3",
+            "--sample-iterations",
+            "1",
+            "--other-iterations",
+            "1",
+        ],
+        "k3i1.csv",
+    );
+    assert!(
+        capped.contains(&format!("hypotheses: {frames} messages")),
+        "{capped}"
+    );
+    assert_ne!(
+        read("k3.csv"),
+        read("k3i1.csv"),
+        "--sample-iterations 1 --other-iterations 1 changed nothing"
     );
 
     let single = run(&["--hypotheses", "1"], "k1.csv");
@@ -150,7 +189,7 @@ fn a_hypothesis_count_out_of_range_or_with_a_board_per_camera_is_refused_clearly
     let one_board = ["--port", "/nonexistent/a", "--seq", "mono"];
     let two_boards = [&common::TWO_ABSENT_BOARDS[..], &["--seq", "stereo"]].concat();
     // (the boards, the options, what the error must name)
-    let cases: [(&[&str], [&str; 2], [&str; 2]); 5] = [
+    let cases: [(&[&str], [&str; 2], [&str; 2]); 7] = [
         (&one_board, ["--hypotheses", "0"], ["--hypotheses", "1..=8"]),
         (&one_board, ["--hypotheses", "9"], ["--hypotheses", "1..=8"]),
         (
@@ -167,6 +206,16 @@ fn a_hypothesis_count_out_of_range_or_with_a_board_per_camera_is_refused_clearly
             &one_board,
             ["--score-every", "2"],
             ["--score-every", "only several hypotheses"],
+        ),
+        (
+            &two_boards,
+            ["--other-iterations", "2"],
+            ["--other-iterations", "one board per camera"],
+        ),
+        (
+            &one_board,
+            ["--sample-iterations", "2"],
+            ["--sample-iterations", "only several hypotheses"],
         ),
     ];
     for (boards, options, named) in cases {

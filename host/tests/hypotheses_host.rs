@@ -406,3 +406,59 @@ fn the_ui_state_carries_the_other_hypotheses_as_ghosts() {
         "{err}"
     );
 }
+
+/// `--sample-iterations` and `--other-iterations` reach the hypotheses: on a whole hand, K = 2
+/// with either capped at one iteration carries other hypotheses than uncapped, while a cap at
+/// the tracker's own number (8) is no cap. Without several hypotheses, or at 0, each is
+/// refused, naming the option.
+#[test]
+fn iteration_caps_reach_the_hypotheses_and_are_refused_where_they_mean_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    render(dir.path(), "fullhand-mono", 7, (160, 120));
+    let track = |name: &str, extra: &[&str]| {
+        let (csv, carried) = (format!("{name}.csv"), format!("{name}-hypotheses.csv"));
+        let mut args = vec!["track", "seq", "-o", &csv, "-q", "--hypotheses", "2"];
+        args.extend_from_slice(&["--hypotheses-out", &carried]);
+        args.extend_from_slice(extra);
+        let out = digiteyes(&args, dir.path());
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        std::fs::read_to_string(dir.path().join(&carried)).unwrap()
+    };
+    let own = track("own", &[]);
+    assert_ne!(
+        own,
+        track("samples", &["--sample-iterations", "1"]),
+        "--sample-iterations 1 changed nothing"
+    );
+    assert_ne!(
+        own,
+        track("others", &["--other-iterations", "1"]),
+        "--other-iterations 1 changed nothing"
+    );
+    assert_eq!(
+        own,
+        track(
+            "at-own",
+            &["--sample-iterations", "8", "--other-iterations", "8"]
+        ),
+        "a cap at the tracker's own number is no cap"
+    );
+    for option in ["--sample-iterations", "--other-iterations"] {
+        for (args, why) in [
+            (vec![option, "2"], "only several hypotheses"),
+            (
+                vec!["--hypotheses", "1", option, "2"],
+                "only several hypotheses",
+            ),
+            (vec!["--hypotheses", "2", option, "0"], "0"),
+        ] {
+            let mut all = vec!["track", "seq", "-o", "bad.csv"];
+            all.extend_from_slice(&args);
+            let out = digiteyes(&all, dir.path());
+            let err = text(&out.stderr);
+            assert!(!out.status.success(), "{args:?} was taken");
+            assert!(err.contains(option) && err.contains(why), "{args:?}: {err}");
+        }
+    }
+    assert!(!dir.path().join("bad.csv").exists());
+}

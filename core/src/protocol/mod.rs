@@ -43,7 +43,10 @@ pub use params::{BadParameter, CameraParams, TrackerParams, WireResidual, WireRo
 /// §4).
 /// Version 9: `Configure` gained `hypotheses_score_every`, the hypotheses scored one frame in
 /// S (issue 11; docs/protocol.md §11).
-pub const PROTOCOL_VERSION: u8 = 9;
+/// Version 10: `Configure` gained `hypotheses_sample_iterations` and
+/// `hypotheses_other_iterations`, caps on the Gauss–Newton iterations of the hypotheses other
+/// than the best (issue 11; docs/protocol.md §11).
+pub const PROTOCOL_VERSION: u8 = 10;
 
 /// Largest `FrameChunk` payload (bytes).
 pub const MAX_CHUNK: usize = 1024;

@@ -7,6 +7,7 @@ use clap::{Args, ValueEnum};
 use digiteyes_core::config::MAX_HYPOTHESES;
 use digiteyes_core::protocol::{Start, TrackerParams};
 
+use super::hypothesis_iterations::HypothesisIterationArgs;
 use super::tracker_config;
 use crate::cli_values;
 use crate::stereo::{stream_stereo, StereoOptions};
@@ -93,6 +94,9 @@ pub struct StreamArgs {
     /// frame in S").
     #[arg(long, value_name = "S", value_parser = clap::value_parser!(u8).range(1..))]
     pub score_every: Option<u8>,
+    /// Caps on the board's hypotheses' iterations (protocol version 10).
+    #[command(flatten)]
+    pub hypothesis_iterations: HypothesisIterationArgs,
     /// Output CSV path (default: states.csv in the current folder).
     #[arg(long, short, default_value = "states.csv", hide_default_value = true)]
     pub out: PathBuf,
@@ -158,11 +162,15 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
                  initial_state only (accepted: --init given); a single board searches itself"
             );
         }
-        if args.hypotheses.is_some() || args.score_every.is_some() {
+        if args.hypotheses.is_some()
+            || args.score_every.is_some()
+            || args.hypothesis_iterations.caps() != [0, 0]
+        {
             bail!(
-                "--hypotheses, --score-every: with one board per camera the host tracks, and \
-                 its stereo tracker carries one hypothesis; leave them out, or stream one \
-                 camera to one board (--camera-index)"
+                "--hypotheses, --score-every, --sample-iterations, --other-iterations: with one \
+                 board per camera the host tracks, and its stereo tracker carries one \
+                 hypothesis; leave them out, or stream one camera to one board \
+                 (--camera-index)"
             );
         }
         if args.camera_index.is_some() {
@@ -198,6 +206,11 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
         super::track::check_score_every(options.hypotheses, s)?;
         options.hypotheses_score_every = s;
     }
+    args.hypothesis_iterations.check(options.hypotheses)?;
+    [
+        options.hypotheses_sample_iterations,
+        options.hypotheses_other_iterations,
+    ] = args.hypothesis_iterations.caps();
     let summary = match (args.seq, args.camera, args.setup) {
         (Some(seq), None, _) => stream_sequence(&seq, &args.out, &options)?,
         (None, Some(camera), Some(setup)) => {

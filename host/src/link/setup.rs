@@ -5,8 +5,8 @@ use std::time::Duration;
 
 use anyhow::{anyhow, bail, Result};
 use digiteyes_core::protocol::{
-    default_hypotheses, default_hypotheses_score_every, default_search_evaluations, model_digest,
-    CameraParams, Start, TrackerParams,
+    default_hypotheses, default_hypotheses_iterations, default_hypotheses_score_every,
+    default_search_evaluations, model_digest, CameraParams, Start, TrackerParams,
 };
 
 use crate::sequence::Sequence;
@@ -45,6 +45,12 @@ pub struct SessionSetup {
     /// The hypotheses are scored one frame in this many, at least 1 (`Configure`; protocol
     /// version 9).
     pub hypotheses_score_every: u8,
+    /// Gauss–Newton iterations at most for each new sample, 0: the tracker's own
+    /// (`Configure`; protocol version 10).
+    pub hypotheses_sample_iterations: u8,
+    /// Gauss–Newton iterations at most for each carried hypothesis other than the best, 0: the
+    /// tracker's own (`Configure`; protocol version 10).
+    pub hypotheses_other_iterations: u8,
     /// [`model_digest`] of the model the frames show; the board's must match.
     pub model_digest: u32,
     /// The model's name for messages (`sequence.json`'s `model`).
@@ -103,6 +109,8 @@ impl SessionSetup {
             search_evaluations_per_frame: default_search_evaluations(),
             hypotheses: default_hypotheses(),
             hypotheses_score_every: default_hypotheses_score_every(),
+            hypotheses_sample_iterations: default_hypotheses_iterations()[0],
+            hypotheses_other_iterations: default_hypotheses_iterations()[1],
             model_digest: model_digest(&sequence.model),
             model_name: sequence.file.model.clone(),
             reply_timeout: DEFAULT_REPLY_TIMEOUT,
