@@ -124,6 +124,17 @@ impl<'a> FrameView<'a> {
         }
     }
 
+    /// Row `y`'s `width` pixels, if inside.
+    #[inline]
+    pub fn row(&self, y: usize) -> Option<&'a [u8]> {
+        if y < self.height {
+            let start = y * self.stride;
+            self.data.get(start..start + self.width)
+        } else {
+            None
+        }
+    }
+
     /// Bilinear intensity at sub-pixel `(x, y)`; `None` outside `[0, w−1] × [0, h−1]` or for
     /// non-finite coordinates.
     pub fn sample(&self, x: f32, y: f32) -> Option<f32> {

@@ -92,6 +92,16 @@ fn accessors_and_pixels() {
     assert_eq!(f.pixel(10, 0), None);
     assert_eq!(f.pixel(0, 6), None);
     assert_eq!(f.pixel(usize::MAX, usize::MAX), None);
+    // A row is its `width` pixels, without the padding; none below the last.
+    for y in 0..6 {
+        let row = f.row(y).unwrap();
+        assert_eq!(row.len(), 8);
+        for (x, &v) in row.iter().enumerate() {
+            assert_eq!(Some(v), f.pixel(x, y));
+        }
+    }
+    assert_eq!(f.row(6), None);
+    assert_eq!(f.row(usize::MAX), None);
 }
 
 #[test]

@@ -63,6 +63,9 @@ fn check_sampling(f: &FrameView, points: &[(f32, f32)], segments: &[(f32, f32, f
         }
         if x.is_finite() && y.is_finite() && x >= 0.0 && y >= 0.0 {
             let _ = f.pixel(x as usize, y as usize);
+            if let Some(row) = f.row(y as usize) {
+                assert_eq!(row.len(), f.width());
+            }
         }
     }
     for &(sx, sy, dx, dy, n) in segments {

@@ -187,7 +187,8 @@ impl<'b> EdgeMap<'b> {
         let step = GRADIENT_STEP_PX.min(s).max(1);
         // Integer gradients: compare squared magnitudes in i32 (at most 2 · 255²).
         let min2 = (min_gradient.max(0.0) * min_gradient.max(0.0)) as i32;
-        let px = |x: usize, y: usize| i32::from(frame.pixel(x, y).unwrap_or(0));
+        let row = |y: usize| frame.row(y).unwrap_or(&[]);
+        let px = |row: &[u8], x: usize| i32::from(row.get(x).copied().unwrap_or(0));
         for cy in 0..self.rows {
             let (y0, y1) = ((cy * s).max(1), ((cy + 1) * s).min(h.saturating_sub(1)));
             for cx in 0..self.cols {
@@ -197,12 +198,14 @@ impl<'b> EdgeMap<'b> {
                 let odd = |v: usize| if step > 1 { v | 1 } else { v };
                 let mut y = odd(y0);
                 while y < y1 {
+                    // The rows above, at and below `y`, looked up once per cell row.
+                    let (above, at, below) = (row(y - 1), row(y), row(y + 1));
                     let mut x = odd(x0);
                     while x < x1 {
-                        let centre = px(x, y);
+                        let centre = px(at, x);
                         region.add(centre);
-                        let gx = px(x + 1, y) - px(x - 1, y);
-                        let gy = px(x, y + 1) - px(x, y - 1);
+                        let gx = px(at, x + 1) - px(at, x - 1);
+                        let gy = px(below, x) - px(above, x);
                         let m2 = gx * gx + gy * gy;
                         if m2 > best.0 {
                             best = (m2, gx, gy);

@@ -125,9 +125,10 @@ impl RegionBuilder {
         let step = GRADIENT_STEP_PX;
         let mut y = 1;
         while y + 1 < h {
+            let row = frame.row(y).unwrap_or(&[]);
             let mut x = 1;
             while x + 1 < w {
-                let v = frame.pixel(x, y).unwrap_or(0);
+                let v = row.get(x).copied().unwrap_or(0);
                 if v >= threshold {
                     n += 1;
                     sx += x as f32;
