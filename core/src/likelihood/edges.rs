@@ -25,6 +25,9 @@ pub const EDGE_BINS: usize = 6;
 /// of at least this size).
 pub const GRADIENT_STEP_PX: usize = 2;
 
+/// Cells of a row whose strongest gradients one sweep along the pixel rows keeps at once.
+const CELL_CHUNK: usize = 64;
+
 /// A cell's distance in chamfer units (3 per cell along a row or column, 4 diagonally),
 /// held at most here (83 cells): low enough that adding 4 cannot overflow a `u8`, so the
 /// passes need no saturating arithmetic.
@@ -189,41 +192,49 @@ impl<'b> EdgeMap<'b> {
         let min2 = (min_gradient.max(0.0) * min_gradient.max(0.0)) as i32;
         let row = |y: usize| frame.row(y).unwrap_or(&[]);
         let px = |row: &[u8], x: usize| i32::from(row.get(x).copied().unwrap_or(0));
+        // Odd rows and columns (every one when the step is 1).
+        let odd = |v: usize| if step > 1 { v | 1 } else { v };
         for cy in 0..self.rows {
             let (y0, y1) = ((cy * s).max(1), ((cy + 1) * s).min(h.saturating_sub(1)));
-            for cx in 0..self.cols {
-                let (x0, x1) = ((cx * s).max(1), ((cx + 1) * s).min(w.saturating_sub(1)));
-                let mut best = (min2, 0i32, 0i32);
-                // Odd rows and columns (every one when the step is 1).
-                let odd = |v: usize| if step > 1 { v | 1 } else { v };
+            // Up to CELL_CHUNK cells of the row at once, so each pixel row is looked up once
+            // per chunk; each cell still visits its pixels row by row, left to right.
+            let mut c0 = 0;
+            while c0 < self.cols {
+                let c1 = (c0 + CELL_CHUNK).min(self.cols);
+                let mut best = [(min2, 0i32, 0i32); CELL_CHUNK];
                 let mut y = odd(y0);
                 while y < y1 {
-                    // The rows above, at and below `y`, looked up once per cell row.
                     let (above, at, below) = (row(y - 1), row(y), row(y + 1));
-                    let mut x = odd(x0);
-                    while x < x1 {
-                        let centre = px(at, x);
-                        region.add(centre);
-                        let gx = px(at, x + 1) - px(at, x - 1);
-                        let gy = px(below, x) - px(above, x);
-                        let m2 = gx * gx + gy * gy;
-                        if m2 > best.0 {
-                            best = (m2, gx, gy);
+                    for (cx, best) in (c0..c1).zip(best.iter_mut()) {
+                        let (x0, x1) = ((cx * s).max(1), ((cx + 1) * s).min(w.saturating_sub(1)));
+                        let mut x = odd(x0);
+                        while x < x1 {
+                            let centre = px(at, x);
+                            region.add(centre);
+                            let gx = px(at, x + 1) - px(at, x - 1);
+                            let gy = px(below, x) - px(above, x);
+                            let m2 = gx * gx + gy * gy;
+                            if m2 > best.0 {
+                                *best = (m2, gx, gy);
+                            }
+                            x += step;
                         }
-                        x += step;
                     }
                     y += step;
                 }
-                if best.0 > min2 {
-                    let (first, second) = bin_of(libm::atan2f(best.2 as f32, best.1 as f32));
-                    let at = cy * self.cols + cx;
-                    self.edge_cells += 1;
-                    for bin in [first, second] {
-                        if let Some(d) = self.plane(bin).get_mut(at) {
-                            *d = 0;
+                for (cx, &(m2, gx, gy)) in (c0..c1).zip(best.iter()) {
+                    if m2 > min2 {
+                        let (first, second) = bin_of(libm::atan2f(gy as f32, gx as f32));
+                        let at = cy * self.cols + cx;
+                        self.edge_cells += 1;
+                        for bin in [first, second] {
+                            if let Some(d) = self.plane(bin).get_mut(at) {
+                                *d = 0;
+                            }
                         }
                     }
                 }
+                c0 = c1;
             }
         }
     }
@@ -351,6 +362,98 @@ fn relax_along<'a>(cells: impl Iterator<Item = &'a mut u8>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    extern crate std;
+    use std::{vec, vec::Vec};
+
+    /// Each cell's strongest gradient found the plain way, cell by cell, every pixel through
+    /// `FrameView::pixel` (the map's gradient pass before it read rows): an oracle for
+    /// [`EdgeMap::mark_edges`]. Returns the marked planes (0 on an edge, `FAR` elsewhere) and the
+    /// edge cells.
+    fn marked_plainly(frame: &FrameView<'_>, s: usize, min_gradient: f32) -> (Vec<u8>, u32) {
+        let (w, h) = (frame.width(), frame.height());
+        let (cols, rows) = (w.div_ceil(s), h.div_ceil(s));
+        let mut planes = vec![FAR; cols * rows * EDGE_BINS];
+        let mut edge_cells = 0;
+        let step = GRADIENT_STEP_PX.min(s).max(1);
+        let min2 = (min_gradient * min_gradient) as i32;
+        let px = |x: usize, y: usize| i32::from(frame.pixel(x, y).unwrap_or(0));
+        let odd = |v: usize| if step > 1 { v | 1 } else { v };
+        for cy in 0..rows {
+            let (y0, y1) = ((cy * s).max(1), ((cy + 1) * s).min(h.saturating_sub(1)));
+            for cx in 0..cols {
+                let (x0, x1) = ((cx * s).max(1), ((cx + 1) * s).min(w.saturating_sub(1)));
+                let mut best = (min2, 0i32, 0i32);
+                let mut y = odd(y0);
+                while y < y1 {
+                    let mut x = odd(x0);
+                    while x < x1 {
+                        let gx = px(x + 1, y) - px(x - 1, y);
+                        let gy = px(x, y + 1) - px(x, y - 1);
+                        let m2 = gx * gx + gy * gy;
+                        if m2 > best.0 {
+                            best = (m2, gx, gy);
+                        }
+                        x += step;
+                    }
+                    y += step;
+                }
+                if best.0 > min2 {
+                    let (first, second) = bin_of(libm::atan2f(best.2 as f32, best.1 as f32));
+                    edge_cells += 1;
+                    for bin in [first, second] {
+                        planes[bin * cols * rows + cy * cols + cx] = 0;
+                    }
+                }
+            }
+        }
+        (planes, edge_cells)
+    }
+
+    /// The gradient pass, which reads pixel rows a chunk of cells at a time, marks the same
+    /// cells as the plain pass, on frames wider than one chunk of cells, with padded rows, at
+    /// every cell size from 1 to 5 px.
+    #[test]
+    fn the_gradient_pass_marks_the_cells_the_plain_pass_marks() {
+        let (w, h, stride) = (401usize, 37usize, 407usize);
+        let mut pixels = vec![0u8; stride * h];
+        let mut seed = 12345u32;
+        for (i, p) in pixels.iter_mut().enumerate() {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            // Noise over a few bright blocks, so strong and weak gradients both occur.
+            let (x, y) = (i % stride, i / stride);
+            let block = if (x / 23 + y / 11) % 3 == 0 { 150 } else { 40 };
+            *p = block + (seed >> 28) as u8;
+        }
+        let frame = FrameView::new(&pixels, w, h, stride).unwrap();
+        for s in 1..=5u8 {
+            let config = LikelihoodConfig {
+                stride_px: s,
+                ..LikelihoodConfig::default()
+            };
+            let mut marked = vec![0u8; EdgeMap::bytes_needed(w, h, s)];
+            let (cols, rows) = (w.div_ceil(usize::from(s)), h.div_ceil(usize::from(s)));
+            assert!(
+                cols > CELL_CHUNK,
+                "the frame spans more than one chunk of cells"
+            );
+            marked.fill(FAR);
+            let mut map = EdgeMap {
+                dist: &mut marked,
+                cols,
+                rows,
+                stride_px: usize::from(s),
+                edge_cells: 0,
+                region: None,
+            };
+            let mut region = RegionBuilder::new(w, h);
+            map.mark_edges(&frame, config.min_gradient, &mut region);
+            let edge_cells = map.edge_cells;
+            let (plain, plain_cells) = marked_plainly(&frame, usize::from(s), config.min_gradient);
+            assert!(plain_cells > 10, "stride {s}: {plain_cells} edge cells");
+            assert_eq!(edge_cells, plain_cells, "stride {s}");
+            assert_eq!(marked, plain, "stride {s}");
+        }
+    }
 
     #[test]
     fn bins_wrap_around_half_a_turn_and_name_the_next_nearest() {
