@@ -50,7 +50,7 @@ enum Owned {
     Ping(u32),
     Chunk(u32, u16, u16, u32, Vec<u8>),
     Reset(Vec<f32>, u32, bool),
-    Configure(u16, u8, u8, [u8; 2]),
+    Configure(u16, u8, u8, [u8; 2], bool),
 }
 
 impl Owned {
@@ -71,7 +71,7 @@ impl Owned {
                 free: *free,
                 start: if *search { Start::Search } else { Start::Given },
             }),
-            Owned::Configure(budget, hypotheses, every, caps) => {
+            Owned::Configure(budget, hypotheses, every, caps, keep) => {
                 HostMessage::Configure(Configure {
                     camera: CameraParams {
                         width: 320,
@@ -88,6 +88,7 @@ impl Owned {
                     hypotheses_score_every: *every,
                     hypotheses_sample_iterations: caps[0],
                     hypotheses_other_iterations: caps[1],
+                    hypotheses_keep_fingers: *keep,
                 })
             }
         }
@@ -111,8 +112,14 @@ fn owned() -> impl Strategy<Value = Owned> {
             any::<bool>()
         )
             .prop_map(|(q, free, search)| Owned::Reset(q, free, search)),
-        (any::<u16>(), any::<u8>(), any::<u8>(), any::<[u8; 2]>())
-            .prop_map(|(b, k, s, caps)| Owned::Configure(b, k, s, caps)),
+        (
+            any::<u16>(),
+            any::<u8>(),
+            any::<u8>(),
+            any::<[u8; 2]>(),
+            any::<bool>()
+        )
+            .prop_map(|(b, k, s, caps, keep)| Owned::Configure(b, k, s, caps, keep)),
     ]
 }
 

@@ -177,6 +177,7 @@ fn host_messages(data: &[u8]) -> std::vec::Vec<HostMessage<'_>> {
             hypotheses_score_every: u8::MAX,
             hypotheses_sample_iterations: u8::MAX,
             hypotheses_other_iterations: u8::MAX,
+            hypotheses_keep_fingers: true,
         }),
         HostMessage::FrameChunk(FrameChunk {
             frame: u32::MAX,

@@ -45,6 +45,7 @@ fn host_messages(data: &[u8]) -> Vec<(&'static str, HostMessage<'_>)> {
                 hypotheses_score_every: 3,
                 hypotheses_sample_iterations: 2,
                 hypotheses_other_iterations: 1,
+                hypotheses_keep_fingers: false,
             }),
         ),
         (
@@ -292,8 +293,8 @@ fn golden_host(name: &str) -> &'static [u8] {
             0x44, 0x08, 0x01, 0x05, 0x14, 0x01, 0x05, 0x80, 0x40, 0x02, 0x01, 0x01, 0x01, 0x02,
             0x40, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x07, 0x7a, 0x44, 0x9a,
             0x99, 0x99, 0x3e, 0x01, 0x08, 0xc0, 0x40, 0x01, 0x92, 0x0a, 0x06, 0x3f, 0x01, 0x01,
-            0x02, 0x3f, 0x0c, 0x1e, 0xe8, 0x07, 0x04, 0x03, 0x02, 0x01, 0xa5, 0x48, 0x30, 0x3e,
-            0x00,
+            0x02, 0x3f, 0x08, 0x1e, 0xe8, 0x07, 0x04, 0x03, 0x02, 0x01, 0x05, 0xa2, 0x88, 0x80,
+            0x74, 0x00,
         ],
         "FrameChunk" => &[
             0x00, 0x05, 0x02, 0x07, 0x04, 0x02, 0x05, 0x08, 0x01, 0x02, 0x03, 0x09, 0xff, 0x04,
@@ -473,7 +474,7 @@ fn an_older_configure_is_a_decode_error(old: &[u8], grown: usize, why: &str) {
     assert_eq!(frame.len(), old.len() + grown, "{why}");
 }
 
-/// Version 9's `Configure` (no caps on the hypotheses' iterations), as a version 9 host sends
+/// Version 9's `Configure` (no caps on the hypotheses' iterations, no finger-undo flag), as a version 9 host sends
 /// it: a version 10 board counts it as a decode error and answers nothing.
 #[test]
 fn version_9_configure_is_a_decode_error() {
@@ -488,7 +489,11 @@ fn version_9_configure_is_a_decode_error() {
         0x01, 0x92, 0x0a, 0x06, 0x3f, 0x01, 0x01, 0x02, 0x3f, 0x0a, 0x1e, 0xe8, 0x07, 0x04, 0x03,
         0x15, 0x8a, 0x64, 0x84, 0x00,
     ];
-    an_older_configure_is_a_decode_error(V9_CONFIGURE, 2, "two bytes more: the two caps");
+    an_older_configure_is_a_decode_error(
+        V9_CONFIGURE,
+        3,
+        "three bytes more: the two caps and the finger-undo flag",
+    );
 }
 
 /// Version 8's `Configure` (no `hypotheses_score_every`), as a version 8 host sends it: a
@@ -508,8 +513,8 @@ fn version_8_configure_is_a_decode_error() {
     ];
     an_older_configure_is_a_decode_error(
         V8_CONFIGURE,
-        1 + 2,
-        "one byte more for the score-every count, two for version 10's caps",
+        1 + 3,
+        "one byte more for the score-every count, three for version 10's caps and flag",
     );
 }
 
@@ -529,9 +534,9 @@ fn version_7_configure_is_a_decode_error() {
     ];
     an_older_configure_is_a_decode_error(
         V7_CONFIGURE,
-        4 + 1 + 2,
-        "four bytes more for the share's f32, one for version 9's score-every count, two for \
-         version 10's caps",
+        4 + 1 + 3,
+        "four bytes more for the share's f32, one for version 9's score-every count, three for \
+         version 10's caps and flag",
     );
 }
 
@@ -551,9 +556,9 @@ fn version_6_configure_is_a_decode_error() {
     ];
     an_older_configure_is_a_decode_error(
         V6_CONFIGURE,
-        4 + 4 + 1 + 2,
+        4 + 4 + 1 + 3,
         "four bytes more for the angle's f32, four for version 8's share, one for version 9's \
-         count, two for version 10's caps",
+         count, three for version 10's caps and flag",
     );
 }
 
@@ -573,9 +578,9 @@ fn version_5_configure_is_a_decode_error() {
     ];
     an_older_configure_is_a_decode_error(
         V5_CONFIGURE,
-        1 + 4 + 4 + 1 + 2,
+        1 + 4 + 4 + 1 + 3,
         "one byte more for the flag, four for version 7's angle, four for version 8's share, \
-         one for version 9's count, two for version 10's caps",
+         one for version 9's count, three for version 10's caps and flag",
     );
 }
 
@@ -596,9 +601,9 @@ fn version_4_configure_is_a_decode_error() {
     ];
     an_older_configure_is_a_decode_error(
         V4_CONFIGURE,
-        2 + 4 + 4 + 1 + 2,
+        2 + 4 + 4 + 1 + 3,
         "the count, version 6's palm flag, version 7's angle, version 8's share, version \
-         9's score-every count and version 10's caps",
+         9's score-every count and version 10's caps and flag",
     );
 }
 

@@ -39,7 +39,8 @@ pub fn search_config(evaluations_per_frame: u16) -> AcquireConfig {
 
 /// The hypotheses a board tracks: the tracker's defaults, as many as `Configure`'s
 /// `hypotheses`, scored one frame in its `hypotheses_score_every`, their iterations capped by
-/// its `hypotheses_sample_iterations` and `hypotheses_other_iterations`, their likelihood's
+/// its `hypotheses_sample_iterations` and `hypotheses_other_iterations`, the finger-undo
+/// candidates weighed as its `hypotheses_keep_fingers` says, their likelihood's
 /// edge map at [`SEARCH_STRIDE_PX`] so it fits the search's buffer ([`Buffers::edge_map`]).
 pub fn hypotheses_config(configure: &Configure) -> HypothesesConfig {
     let defaults = HypothesesConfig::default();
@@ -48,6 +49,7 @@ pub fn hypotheses_config(configure: &Configure) -> HypothesesConfig {
         score_every_frames: configure.hypotheses_score_every,
         sample_iterations: configure.hypotheses_sample_iterations,
         other_iterations: configure.hypotheses_other_iterations,
+        keep_fingers: configure.hypotheses_keep_fingers,
         likelihood: LikelihoodConfig {
             stride_px: SEARCH_STRIDE_PX,
             ..defaults.likelihood
@@ -94,6 +96,7 @@ mod tests {
             hypotheses_score_every: score_every,
             hypotheses_sample_iterations: iterations[0],
             hypotheses_other_iterations: iterations[1],
+            hypotheses_keep_fingers: false,
         }
     }
 
@@ -118,6 +121,7 @@ mod tests {
             assert_eq!(config.count, k);
             assert_eq!(config.score_every_frames, 3);
             assert_eq!((config.sample_iterations, config.other_iterations), (2, 1));
+            assert!(!config.keep_fingers);
             assert_eq!(config.likelihood.stride_px, SEARCH_STRIDE_PX);
             for (w, h) in [(640, 480), (320, 240), (161, 119)] {
                 assert_eq!(

@@ -32,6 +32,7 @@ fn configure(stats_every: u16, features_every: u16) -> HostMessage<'static> {
         hypotheses_score_every: 1,
         hypotheses_sample_iterations: 0,
         hypotheses_other_iterations: 0,
+        hypotheses_keep_fingers: true,
     })
 }
 
@@ -358,6 +359,7 @@ fn bad_commands_are_refused_and_change_nothing() {
         hypotheses_score_every: 1,
         hypotheses_sample_iterations: 0,
         hypotheses_other_iterations: 0,
+        hypotheses_keep_fingers: true,
     }));
     params.iterations = 0;
     pipe.send(&HostMessage::Configure(Configure {
@@ -370,6 +372,7 @@ fn bad_commands_are_refused_and_change_nothing() {
         hypotheses_score_every: 1,
         hypotheses_sample_iterations: 0,
         hypotheses_other_iterations: 0,
+        hypotheses_keep_fingers: true,
     }));
     let mut big = good_cam;
     big.width *= 2;
@@ -383,6 +386,7 @@ fn bad_commands_are_refused_and_change_nothing() {
         hypotheses_score_every: 1,
         hypotheses_sample_iterations: 0,
         hypotheses_other_iterations: 0,
+        hypotheses_keep_fingers: true,
     }));
     pipe.send(&configure(0, 0));
     pipe.send(&HostMessage::Reset(Reset {

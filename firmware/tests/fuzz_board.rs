@@ -58,6 +58,7 @@ proptest! {
             hypotheses_score_every: 1,
             hypotheses_sample_iterations: 0,
             hypotheses_other_iterations: 0,
+            hypotheses_keep_fingers: true,
         }));
         host.send(&HostMessage::Reset(Reset { q: q0.iter().copied().collect(), free: 0b1111_0000, start: Start::Given }));
         for n in 0..3 {

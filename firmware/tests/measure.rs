@@ -37,6 +37,7 @@ fn configure() -> HostMessage<'static> {
         hypotheses_score_every: 1,
         hypotheses_sample_iterations: 0,
         hypotheses_other_iterations: 0,
+        hypotheses_keep_fingers: true,
     })
 }
 

@@ -42,6 +42,7 @@ fn configure(iterations: u8, budget: u16) -> HostMessage<'static> {
         hypotheses_score_every: 1,
         hypotheses_sample_iterations: 0,
         hypotheses_other_iterations: 0,
+        hypotheses_keep_fingers: true,
     })
 }
 

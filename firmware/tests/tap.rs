@@ -48,6 +48,7 @@ fn the_tap_sees_every_frame_of_a_pass_with_its_pixels_and_state() {
         hypotheses_score_every: 1,
         hypotheses_sample_iterations: 0,
         hypotheses_other_iterations: 0,
+        hypotheses_keep_fingers: true,
     }));
     board.serial_mut().send(&HostMessage::Reset(Reset {
         q: q0.iter().copied().collect(),

@@ -18,8 +18,8 @@ use std::time::Duration;
 
 use anyhow::{anyhow, ensure, Context, Result};
 use digiteyes_core::protocol::{
-    default_hypotheses, default_hypotheses_iterations, default_hypotheses_score_every,
-    default_search_evaluations, Start, State, TrackerParams,
+    default_hypotheses, default_hypotheses_iterations, default_hypotheses_keep_fingers,
+    default_hypotheses_score_every, default_search_evaluations, Start, State, TrackerParams,
 };
 use digiteyes_core::status::Status;
 use digiteyes_core::tracker::FrameReport;
@@ -74,6 +74,8 @@ pub struct StreamOptions {
     /// Gauss–Newton iterations at most for each carried hypothesis other than the best
     /// (`Configure`; 0: the tracker's own).
     pub hypotheses_other_iterations: u8,
+    /// Whether the finger-undo candidates are weighed (`Configure`).
+    pub hypotheses_keep_fingers: bool,
     /// Show a progress bar (when stderr is a terminal).
     pub progress: bool,
 }
@@ -93,6 +95,7 @@ impl StreamOptions {
             hypotheses_score_every: default_hypotheses_score_every(),
             hypotheses_sample_iterations: default_hypotheses_iterations()[0],
             hypotheses_other_iterations: default_hypotheses_iterations()[1],
+            hypotheses_keep_fingers: default_hypotheses_keep_fingers(),
             progress: false,
         }
     }
@@ -372,6 +375,7 @@ fn connect(sequence: &Sequence, options: &StreamOptions) -> Result<Session> {
     setup.hypotheses_score_every = options.hypotheses_score_every;
     setup.hypotheses_sample_iterations = options.hypotheses_sample_iterations;
     setup.hypotheses_other_iterations = options.hypotheses_other_iterations;
+    setup.hypotheses_keep_fingers = options.hypotheses_keep_fingers;
     setup.reply_timeout = options.reply_timeout;
     let link = Link::open(&options.port, options.baud)?;
     Session::start(link, setup)

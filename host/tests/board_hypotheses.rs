@@ -189,39 +189,52 @@ fn a_hypothesis_count_out_of_range_or_with_a_board_per_camera_is_refused_clearly
     let one_board = ["--port", "/nonexistent/a", "--seq", "mono"];
     let two_boards = [&common::TWO_ABSENT_BOARDS[..], &["--seq", "stereo"]].concat();
     // (the boards, the options, what the error must name)
-    let cases: [(&[&str], [&str; 2], [&str; 2]); 7] = [
-        (&one_board, ["--hypotheses", "0"], ["--hypotheses", "1..=8"]),
-        (&one_board, ["--hypotheses", "9"], ["--hypotheses", "1..=8"]),
+    let cases: [(&[&str], &[&str], [&str; 2]); 8] = [
+        (
+            &one_board,
+            &["--hypotheses", "0"],
+            ["--hypotheses", "1..=8"],
+        ),
+        (
+            &one_board,
+            &["--hypotheses", "9"],
+            ["--hypotheses", "1..=8"],
+        ),
         (
             &two_boards,
-            ["--hypotheses", "2"],
+            &["--hypotheses", "2"],
             ["--hypotheses", "one board per camera"],
         ),
         (
             &two_boards,
-            ["--score-every", "2"],
+            &["--score-every", "2"],
             ["--score-every", "one board per camera"],
         ),
         (
             &one_board,
-            ["--score-every", "2"],
+            &["--score-every", "2"],
             ["--score-every", "only several hypotheses"],
         ),
         (
             &two_boards,
-            ["--other-iterations", "2"],
+            &["--other-iterations", "2"],
             ["--other-iterations", "one board per camera"],
         ),
         (
             &one_board,
-            ["--sample-iterations", "2"],
+            &["--sample-iterations", "2"],
             ["--sample-iterations", "only several hypotheses"],
+        ),
+        (
+            &one_board,
+            &["--no-keep-fingers"],
+            ["--no-keep-fingers", "only several hypotheses"],
         ),
     ];
     for (boards, options, named) in cases {
         let mut args = vec!["stream"];
         args.extend_from_slice(boards);
-        args.extend_from_slice(&options);
+        args.extend_from_slice(options);
         let stderr = common::refused(dir.path(), &args);
         assert!(
             named.iter().all(|n| stderr.contains(n)),

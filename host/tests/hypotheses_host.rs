@@ -408,9 +408,11 @@ fn the_ui_state_carries_the_other_hypotheses_as_ghosts() {
 }
 
 /// `--sample-iterations` and `--other-iterations` reach the hypotheses: on a whole hand, K = 2
-/// with either capped at one iteration carries other hypotheses than uncapped, while a cap at
-/// the tracker's own number (8) is no cap. Without several hypotheses, or at 0, each is
-/// refused, naming the option.
+/// with either cap at one iteration carries other hypotheses than by default, while a cap at the
+/// tracker's own number (8) is no cap. Without several hypotheses (or a cap at 0) each, and
+/// `--no-keep-fingers`, is refused, naming the option. (No finger-undo candidate is kept on
+/// these frames, so `--no-keep-fingers` shows nothing in the output here; the option's mapping
+/// is checked in `cli::hypothesis_budget`.)
 #[test]
 fn iteration_caps_reach_the_hypotheses_and_are_refused_where_they_mean_nothing() {
     let dir = tempfile::tempdir().unwrap();
@@ -459,6 +461,20 @@ fn iteration_caps_reach_the_hypotheses_and_are_refused_where_they_mean_nothing()
             assert!(!out.status.success(), "{args:?} was taken");
             assert!(err.contains(option) && err.contains(why), "{args:?}: {err}");
         }
+    }
+    for args in [
+        vec!["--no-keep-fingers"],
+        vec!["--hypotheses", "1", "--no-keep-fingers"],
+    ] {
+        let mut all = vec!["track", "seq", "-o", "bad.csv"];
+        all.extend_from_slice(&args);
+        let out = digiteyes(&all, dir.path());
+        let err = text(&out.stderr);
+        assert!(!out.status.success(), "{args:?} was taken");
+        assert!(
+            err.contains("--no-keep-fingers") && err.contains("only several hypotheses"),
+            "{args:?}: {err}"
+        );
     }
     assert!(!dir.path().join("bad.csv").exists());
 }

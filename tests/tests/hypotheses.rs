@@ -140,6 +140,40 @@ fn hypotheses_never_exceed_their_count_and_the_best_comes_first() {
     assert!(multi.track(&[view(&image)], &mut []).is_err());
 }
 
+/// With `keep_fingers` each scored frame also weighs the best with each finger's update undone
+/// and with every finger's undone: six more candidates on the five-fingered model, none kept on
+/// these frames, so six more dropped. Without it they are not made.
+#[test]
+fn the_finger_undo_candidates_are_weighed_only_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = Sequence::open(&common::mouse(dir.path(), 6)).unwrap();
+    let dropped = |keep_fingers: bool| -> Vec<u8> {
+        let config = HypothesesConfig {
+            count: 2,
+            keep_fingers,
+            ..HypothesesConfig::default()
+        };
+        let mut bufs = buffers(&seq.cameras, &config);
+        let mut multi = MultiTracker::new(sequence_tracker(&seq), config);
+        (0..seq.frames)
+            .map(|k| {
+                let image = seq.read_frame(0, k).unwrap();
+                let mut slices: Vec<&mut [u8]> =
+                    bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
+                multi.track(&[view(&image)], &mut slices).unwrap().dropped
+            })
+            .collect()
+    };
+    let (with, without) = (dropped(true), dropped(false));
+    for (k, (w, o)) in with.iter().zip(&without).enumerate() {
+        assert_eq!(
+            *w,
+            o + 6,
+            "frame {k}: five fingers undone one at a time and all at once: {with:?} {without:?}"
+        );
+    }
+}
+
 /// `track_at_most` caps the Gauss–Newton iterations of one frame and puts the tracker's own
 /// number back; a cap of 0, or above the tracker's own, is `track` bit for bit.
 #[test]

@@ -414,6 +414,11 @@ pub struct Configure {
     /// K = 4 scored one frame in 4 costs a 480 MHz M7 about 23 ms a frame on the mean
     /// (docs/hypotheses.md, "Fewer iterations for the hypotheses other than the best").
     pub hypotheses_other_iterations: u8,
+    /// Whether each scored frame also weighs the best with each finger's update undone and
+    /// with every finger's undone (version 10; `hypotheses::HypothesesConfig::keep_fingers`;
+    /// default [`default_hypotheses_keep_fingers`], true). Off saves up to six candidates'
+    /// scores a scored frame (docs/hypotheses.md, "Two hypotheses on every frame of a board").
+    pub hypotheses_keep_fingers: bool,
 }
 
 /// The search budget per frame a host sends by default: the search's own default.
@@ -436,6 +441,12 @@ pub fn default_hypotheses_score_every() -> u8 {
 pub fn default_hypotheses_iterations() -> [u8; 2] {
     let defaults = HypothesesConfig::default();
     [defaults.sample_iterations, defaults.other_iterations]
+}
+
+/// Whether a host asks the finger-undo candidates weighed by default: the tracker's own
+/// default.
+pub fn default_hypotheses_keep_fingers() -> bool {
+    HypothesesConfig::default().keep_fingers
 }
 
 /// Whether `count` is a hypothesis count a board takes: 1..=[`MAX_HYPOTHESES`].

@@ -45,7 +45,8 @@ pub use params::{BadParameter, CameraParams, TrackerParams, WireResidual, WireRo
 /// S (issue 11; docs/protocol.md §11).
 /// Version 10: `Configure` gained `hypotheses_sample_iterations` and
 /// `hypotheses_other_iterations`, caps on the Gauss–Newton iterations of the hypotheses other
-/// than the best (issue 11; docs/protocol.md §11).
+/// than the best, and `hypotheses_keep_fingers`, whether the finger-undo candidates are weighed
+/// (issue 11; docs/protocol.md §11).
 pub const PROTOCOL_VERSION: u8 = 10;
 
 /// Largest `FrameChunk` payload (bytes).

@@ -7,7 +7,7 @@ use clap::{Args, ValueEnum};
 use digiteyes_core::config::MAX_HYPOTHESES;
 use digiteyes_core::protocol::{Start, TrackerParams};
 
-use super::hypothesis_iterations::HypothesisIterationArgs;
+use super::hypothesis_budget::HypothesisBudgetArgs;
 use super::tracker_config;
 use crate::cli_values;
 use crate::stereo::{stream_stereo, StereoOptions};
@@ -94,9 +94,9 @@ pub struct StreamArgs {
     /// frame in S").
     #[arg(long, value_name = "S", value_parser = clap::value_parser!(u8).range(1..))]
     pub score_every: Option<u8>,
-    /// Caps on the board's hypotheses' iterations (protocol version 10).
+    /// What the board's hypotheses other than the best may cost (protocol version 10).
     #[command(flatten)]
-    pub hypothesis_iterations: HypothesisIterationArgs,
+    pub hypothesis_budget: HypothesisBudgetArgs,
     /// Output CSV path (default: states.csv in the current folder).
     #[arg(long, short, default_value = "states.csv", hide_default_value = true)]
     pub out: PathBuf,
@@ -143,9 +143,50 @@ impl From<InitArg> for Start {
     }
 }
 
+/// The hypotheses' options of `stream`, apart from the rest (which `run` takes apart).
+#[derive(Clone, Copy)]
+struct HypothesesArgs {
+    hypotheses: Option<u8>,
+    score_every: Option<u8>,
+    hypothesis_budget: HypothesisBudgetArgs,
+}
+
+impl HypothesesArgs {
+    fn of(args: &StreamArgs) -> Self {
+        HypothesesArgs {
+            hypotheses: args.hypotheses,
+            score_every: args.score_every,
+            hypothesis_budget: args.hypothesis_budget,
+        }
+    }
+}
+
+/// Sets the board's hypotheses in `options` as `args` ask (count, scoring period, budget),
+/// refusing what means nothing with one hypothesis.
+fn apply_hypotheses(args: HypothesesArgs, options: &mut StreamOptions) -> Result<()> {
+    if let Some(k) = args.hypotheses {
+        options.hypotheses = k;
+    }
+    if let Some(s) = args.score_every {
+        super::track::check_score_every(options.hypotheses, s)?;
+        options.hypotheses_score_every = s;
+    }
+    let budget = args.hypothesis_budget;
+    budget.check(options.hypotheses)?;
+    if let Some(n) = budget.sample_iterations {
+        options.hypotheses_sample_iterations = n;
+    }
+    if let Some(n) = budget.other_iterations {
+        options.hypotheses_other_iterations = n;
+    }
+    options.hypotheses_keep_fingers &= !budget.no_keep_fingers;
+    Ok(())
+}
+
 /// Streams to the board(s), writes the CSV and prints the summary; fails when no frame was
 /// tracked.
 pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
+    let hypotheses = HypothesesArgs::of(&args);
     let port = args.port;
     let tracker = TrackerParams::from_config(&tracker_config(args.iterations, false));
     if port.port.len() > 1 {
@@ -162,15 +203,12 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
                  initial_state only (accepted: --init given); a single board searches itself"
             );
         }
-        if args.hypotheses.is_some()
-            || args.score_every.is_some()
-            || args.hypothesis_iterations.caps() != [0, 0]
-        {
+        if args.hypotheses.is_some() || args.score_every.is_some() || args.hypothesis_budget.any() {
             bail!(
-                "--hypotheses, --score-every, --sample-iterations, --other-iterations: with one \
-                 board per camera the host tracks, and its stereo tracker carries one \
-                 hypothesis; leave them out, or stream one camera to one board \
-                 (--camera-index)"
+                "--hypotheses, --score-every, --sample-iterations, --other-iterations, \
+                 --no-keep-fingers: with one board per camera the host tracks, and its stereo \
+                 tracker carries one hypothesis; leave them out, or stream one camera to one \
+                 board (--camera-index)"
             );
         }
         if args.camera_index.is_some() {
@@ -199,18 +237,7 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
     if let Some(n) = args.search_evaluations {
         options.search_evaluations_per_frame = n;
     }
-    if let Some(k) = args.hypotheses {
-        options.hypotheses = k;
-    }
-    if let Some(s) = args.score_every {
-        super::track::check_score_every(options.hypotheses, s)?;
-        options.hypotheses_score_every = s;
-    }
-    args.hypothesis_iterations.check(options.hypotheses)?;
-    [
-        options.hypotheses_sample_iterations,
-        options.hypotheses_other_iterations,
-    ] = args.hypothesis_iterations.caps();
+    apply_hypotheses(hypotheses, &mut options)?;
     let summary = match (args.seq, args.camera, args.setup) {
         (Some(seq), None, _) => stream_sequence(&seq, &args.out, &options)?,
         (None, Some(camera), Some(setup)) => {
@@ -220,4 +247,65 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
     };
     println!("{summary}");
     summary.ensure_some_tracked()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+    use digiteyes_core::protocol::default_hypotheses;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        stream: StreamArgs,
+    }
+
+    fn options(args: &[&str]) -> Result<StreamOptions> {
+        let base = ["stream", "--port", "/dev/null", "--seq", "seq"];
+        let cli = Cli::try_parse_from([&base[..], args].concat())?;
+        let mut options = StreamOptions::new("/dev/null");
+        apply_hypotheses(HypothesesArgs::of(&cli.stream), &mut options)?;
+        Ok(options)
+    }
+
+    /// What `Configure` then carries: the hypotheses' count, scoring period and budget as
+    /// given, the defaults otherwise (the board applies each: `firmware/tests/hypotheses.rs`).
+    #[test]
+    fn the_hypotheses_options_reach_what_the_board_is_configured_with() {
+        let defaults = options(&[]).unwrap();
+        assert_eq!(defaults.hypotheses, default_hypotheses());
+        assert!(defaults.hypotheses_keep_fingers);
+        assert_eq!(
+            (
+                defaults.hypotheses_sample_iterations,
+                defaults.hypotheses_other_iterations
+            ),
+            (0, 0)
+        );
+        let asked = options(&[
+            "--hypotheses",
+            "2",
+            "--score-every",
+            "4",
+            "--sample-iterations",
+            "2",
+            "--other-iterations",
+            "3",
+            "--no-keep-fingers",
+        ])
+        .unwrap();
+        assert_eq!(
+            (
+                asked.hypotheses,
+                asked.hypotheses_score_every,
+                asked.hypotheses_sample_iterations,
+                asked.hypotheses_other_iterations,
+                asked.hypotheses_keep_fingers
+            ),
+            (2, 4, 2, 3, false)
+        );
+        let err = options(&["--no-keep-fingers"]).unwrap_err().to_string();
+        assert!(err.contains("--no-keep-fingers"), "{err}");
+    }
 }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 
-use super::hypothesis_iterations::HypothesisIterationArgs;
+use super::hypothesis_budget::HypothesisBudgetArgs;
 use super::tracker_config;
 use crate::acquire::Recovery;
 use crate::track::{track_sequence_to, Init, TrackOptions, TrackOutputs};
@@ -47,7 +47,8 @@ use digiteyes_core::hypotheses::HypothesesConfig;
 /// frame in S only (and after a lost frame), and only tracked between: K = 2 at S = 4 costs
 /// about half of K = 2's instructions a frame on the mean (docs/hypotheses.md, "Scoring one
 /// frame in S"). --sample-iterations and --other-iterations cap the Gauss–Newton iterations
-/// of the new samples and of the carried hypotheses other than the best.
+/// of the new samples and of the carried hypotheses other than the best; --no-keep-fingers
+/// drops the candidates that undo each finger's update.
 #[derive(Args, Debug)]
 pub struct TrackArgs {
     /// Sequence folder.
@@ -88,9 +89,9 @@ pub struct TrackArgs {
     /// every frame).
     #[arg(long, value_name = "S", default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..))]
     pub score_every: u8,
-    /// Caps on the hypotheses' iterations.
+    /// What the hypotheses other than the best may cost.
     #[command(flatten)]
-    pub hypothesis_iterations: HypothesisIterationArgs,
+    pub hypothesis_budget: HypothesisBudgetArgs,
 }
 
 /// Refuses `--score-every` above 1 for a single hypothesis, where it would change nothing.
@@ -135,8 +136,7 @@ pub enum RecoverArg {
 /// Tracks the sequence and prints the summary; `progress`: a progress bar on stderr.
 pub fn run(args: TrackArgs, progress: bool) -> Result<()> {
     check_score_every(args.hypotheses, args.score_every)?;
-    args.hypothesis_iterations.check(args.hypotheses)?;
-    let [sample_iterations, other_iterations] = args.hypothesis_iterations.caps();
+    args.hypothesis_budget.check(args.hypotheses)?;
     let config = tracker_config(args.iterations, args.no_predict);
     let options = TrackOptions {
         init: args.init.map(|i| match i {
@@ -147,13 +147,11 @@ pub fn run(args: TrackArgs, progress: bool) -> Result<()> {
             RecoverArg::Search => Recovery::Search,
             RecoverArg::Never => Recovery::Never,
         },
-        hypotheses: HypothesesConfig {
+        hypotheses: args.hypothesis_budget.applied(HypothesesConfig {
             count: args.hypotheses,
             score_every_frames: args.score_every,
-            sample_iterations,
-            other_iterations,
             ..HypothesesConfig::default()
-        },
+        }),
         ..TrackOptions::default()
     };
     let outputs = TrackOutputs {

@@ -307,6 +307,7 @@ impl Session {
             hypotheses_score_every: self.setup.hypotheses_score_every,
             hypotheses_sample_iterations: self.setup.hypotheses_sample_iterations,
             hypotheses_other_iterations: self.setup.hypotheses_other_iterations,
+            hypotheses_keep_fingers: self.setup.hypotheses_keep_fingers,
         });
         self.command(&configure, Command::Configure)?;
         // A search starts from the same base as the host's own (`track --init auto`).

@@ -5,8 +5,9 @@ use std::time::Duration;
 
 use anyhow::{anyhow, bail, Result};
 use digiteyes_core::protocol::{
-    default_hypotheses, default_hypotheses_iterations, default_hypotheses_score_every,
-    default_search_evaluations, model_digest, CameraParams, Start, TrackerParams,
+    default_hypotheses, default_hypotheses_iterations, default_hypotheses_keep_fingers,
+    default_hypotheses_score_every, default_search_evaluations, model_digest, CameraParams, Start,
+    TrackerParams,
 };
 
 use crate::sequence::Sequence;
@@ -51,6 +52,8 @@ pub struct SessionSetup {
     /// Gauss–Newton iterations at most for each carried hypothesis other than the best, 0: the
     /// tracker's own (`Configure`; protocol version 10).
     pub hypotheses_other_iterations: u8,
+    /// Whether the finger-undo candidates are weighed (`Configure`; protocol version 10).
+    pub hypotheses_keep_fingers: bool,
     /// [`model_digest`] of the model the frames show; the board's must match.
     pub model_digest: u32,
     /// The model's name for messages (`sequence.json`'s `model`).
@@ -111,6 +114,7 @@ impl SessionSetup {
             hypotheses_score_every: default_hypotheses_score_every(),
             hypotheses_sample_iterations: default_hypotheses_iterations()[0],
             hypotheses_other_iterations: default_hypotheses_iterations()[1],
+            hypotheses_keep_fingers: default_hypotheses_keep_fingers(),
             model_digest: model_digest(&sequence.model),
             model_name: sequence.file.model.clone(),
             reply_timeout: DEFAULT_REPLY_TIMEOUT,
