@@ -77,6 +77,18 @@ fn hypotheses_1_writes_todays_states_byte_for_byte_and_bad_counts_are_refused() 
     assert!(!dir.path().join("bad.csv").exists());
 }
 
+/// `digiteyes track seq --hypotheses 2 EXTRA…` in `dir`, its hypotheses written to
+/// `NAME-hypotheses.csv`: returns that file's text.
+fn track_two(dir: &Path, name: &str, extra: &[&str]) -> String {
+    let (csv, carried) = (format!("{name}.csv"), format!("{name}-hypotheses.csv"));
+    let mut args = vec!["track", "seq", "-o", &csv, "-q", "--hypotheses", "2"];
+    args.extend_from_slice(&["--hypotheses-out", &carried]);
+    args.extend_from_slice(extra);
+    let out = digiteyes(&args, dir);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    std::fs::read_to_string(dir.join(&carried)).unwrap()
+}
+
 /// `--score-every S` reaches the hypotheses: on a whole hand, K = 2 scored one frame in 3
 /// carries other hypotheses (`--hypotheses-out`: scores, ages, states) than K = 2 scored
 /// every frame, the same on a second run (deterministic), and the first frame's alike (it is
@@ -85,15 +97,7 @@ fn hypotheses_1_writes_todays_states_byte_for_byte_and_bad_counts_are_refused() 
 fn score_every_reaches_the_hypotheses_and_is_refused_where_it_means_nothing() {
     let dir = tempfile::tempdir().unwrap();
     render(dir.path(), "fullhand-mono", 7, (160, 120));
-    let track = |name: &str, extra: &[&str]| {
-        let (csv, carried) = (format!("{name}.csv"), format!("{name}-hypotheses.csv"));
-        let mut args = vec!["track", "seq", "-o", &csv, "-q", "--hypotheses", "2"];
-        args.extend_from_slice(&["--hypotheses-out", &carried]);
-        args.extend_from_slice(extra);
-        let out = digiteyes(&args, dir.path());
-        assert!(out.status.success(), "{}", text(&out.stderr));
-        std::fs::read_to_string(dir.path().join(&carried)).unwrap()
-    };
+    let track = |name: &str, extra: &[&str]| track_two(dir.path(), name, extra);
     let every = track("every", &[]);
     let one_in_three = track("three", &["--score-every", "3"]);
     let again = track("again", &["--score-every", "3"]);
@@ -417,15 +421,7 @@ fn the_ui_state_carries_the_other_hypotheses_as_ghosts() {
 fn iteration_caps_reach_the_hypotheses_and_are_refused_where_they_mean_nothing() {
     let dir = tempfile::tempdir().unwrap();
     render(dir.path(), "fullhand-mono", 7, (160, 120));
-    let track = |name: &str, extra: &[&str]| {
-        let (csv, carried) = (format!("{name}.csv"), format!("{name}-hypotheses.csv"));
-        let mut args = vec!["track", "seq", "-o", &csv, "-q", "--hypotheses", "2"];
-        args.extend_from_slice(&["--hypotheses-out", &carried]);
-        args.extend_from_slice(extra);
-        let out = digiteyes(&args, dir.path());
-        assert!(out.status.success(), "{}", text(&out.stderr));
-        std::fs::read_to_string(dir.path().join(&carried)).unwrap()
-    };
+    let track = |name: &str, extra: &[&str]| track_two(dir.path(), name, extra);
     let own = track("own", &[]);
     assert_ne!(
         own,
