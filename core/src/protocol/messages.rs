@@ -417,7 +417,7 @@ pub struct Configure {
     /// Whether each scored frame also weighs the best with each finger's update undone and
     /// with every finger's undone (version 10; `hypotheses::HypothesesConfig::keep_fingers`;
     /// default [`default_hypotheses_keep_fingers`], true). Off saves up to six candidates'
-    /// scores a scored frame (docs/hypotheses.md, "Two hypotheses on every frame of a board").
+    /// scores a scored frame (docs/hypotheses.md, "Two hypotheses within a board's frame budget").
     pub hypotheses_keep_fingers: bool,
 }
 
