@@ -23,8 +23,8 @@ pub struct HypothesisBudgetArgs {
     pub other_iterations: Option<u8>,
     /// With --hypotheses K > 1: do not also score the best with each finger's update undone
     /// (by default every scored frame weighs those candidates). Saves the scores of up to six
-    /// candidates a scored frame: with K = 2 scored one frame in 4 and both caps at 2, a 480 MHz
-    /// Cortex-M7's dearest whole-hand frame comes within 10 % of 33 ms (docs/hypotheses.md,
+    /// candidates a scored frame: with K = 2 scored one frame in 4 and both caps at 1, a 480 MHz
+    /// Cortex-M7 answered every frame of a whole-hand sequence within 33 ms (docs/hypotheses.md,
     /// "Two hypotheses within a board's frame budget").
     #[arg(long)]
     pub no_keep_fingers: bool,
