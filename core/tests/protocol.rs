@@ -527,3 +527,43 @@ fn hypothesis_counts_and_the_largest_hypotheses_message() {
     };
     assert_eq!(h.hypotheses.len(), MAX_HYPOTHESES);
 }
+
+/// `Configure::new` is what a host sends when it names only the camera and the tracker: each
+/// other field at its published default, and it round-trips like any message.
+#[test]
+fn a_configure_with_the_defaults_names_only_the_camera_and_the_tracker() {
+    let tracker = TrackerParams {
+        iterations: 3,
+        ..TrackerParams::default()
+    };
+    let configure = Configure::new(camera(), tracker);
+    assert_eq!((configure.camera, configure.tracker), (camera(), tracker));
+    assert_eq!((configure.features_every, configure.stats_every), (0, 0));
+    assert_eq!(
+        configure.search_evaluations_per_frame,
+        default_search_evaluations()
+    );
+    assert_eq!(configure.hypotheses, default_hypotheses());
+    assert_eq!(
+        configure.hypotheses_score_every,
+        default_hypotheses_score_every()
+    );
+    assert_eq!(
+        [
+            configure.hypotheses_sample_iterations,
+            configure.hypotheses_other_iterations
+        ],
+        default_hypotheses_iterations()
+    );
+    assert_eq!(
+        configure.hypotheses_keep_fingers,
+        default_hypotheses_keep_fingers()
+    );
+    assert!(hypotheses_in_range(configure.hypotheses));
+    let message = HostMessage::Configure(configure);
+    let mut buf = [0u8; MAX_MESSAGE];
+    let frame = encode(&message, &mut buf).unwrap();
+    let mut rx = Decoder::<MAX_MESSAGE>::new();
+    let (_, decoded) = rx.feed::<HostMessage>(frame);
+    assert_eq!(decoded.unwrap().unwrap(), message);
+}

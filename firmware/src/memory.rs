@@ -78,25 +78,22 @@ mod tests {
     use digiteyes_core::protocol::{CameraParams, TrackerParams};
 
     /// A `Configure` asking for `count` hypotheses scored one frame in `score_every`, their
-    /// iterations capped at `[sample, other]`.
+    /// iterations capped at `[sample, other]`, without the finger-undo candidates.
     fn configure(count: u8, score_every: u8, iterations: [u8; 2]) -> Configure {
+        let camera = CameraParams {
+            width: 320,
+            height: 240,
+            intrinsics: [400.0, 400.0, 160.0, 120.0],
+            r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+            t: [0.0, 0.0, 500.0],
+        };
         Configure {
-            camera: CameraParams {
-                width: 320,
-                height: 240,
-                intrinsics: [400.0, 400.0, 160.0, 120.0],
-                r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
-                t: [0.0, 0.0, 500.0],
-            },
-            tracker: TrackerParams::default(),
-            features_every: 0,
-            stats_every: 0,
-            search_evaluations_per_frame: 100,
             hypotheses: count,
             hypotheses_score_every: score_every,
             hypotheses_sample_iterations: iterations[0],
             hypotheses_other_iterations: iterations[1],
             hypotheses_keep_fingers: false,
+            ..Configure::new(camera, TrackerParams::default())
         }
     }
 

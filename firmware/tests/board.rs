@@ -23,16 +23,12 @@ fn free_mask() -> u32 {
 
 fn configure(stats_every: u16, features_every: u16) -> HostMessage<'static> {
     HostMessage::Configure(Configure {
-        camera: CameraParams::from_camera(&camera()).unwrap(),
-        tracker: TrackerParams::default(),
         features_every,
         stats_every,
-        search_evaluations_per_frame: default_search_evaluations(),
-        hypotheses: 1,
-        hypotheses_score_every: 1,
-        hypotheses_sample_iterations: 0,
-        hypotheses_other_iterations: 0,
-        hypotheses_keep_fingers: true,
+        ..Configure::new(
+            CameraParams::from_camera(&camera()).unwrap(),
+            TrackerParams::default(),
+        )
     })
 }
 
@@ -349,45 +345,15 @@ fn bad_commands_are_refused_and_change_nothing() {
     let good_cam = cam;
     cam.intrinsics[0] = -1.0;
     let mut params = TrackerParams::default();
-    pipe.send(&HostMessage::Configure(Configure {
-        camera: cam,
-        tracker: params,
-        features_every: 0,
-        stats_every: 0,
-        search_evaluations_per_frame: default_search_evaluations(),
-        hypotheses: 1,
-        hypotheses_score_every: 1,
-        hypotheses_sample_iterations: 0,
-        hypotheses_other_iterations: 0,
-        hypotheses_keep_fingers: true,
-    }));
+    pipe.send(&HostMessage::Configure(Configure::new(cam, params)));
     params.iterations = 0;
-    pipe.send(&HostMessage::Configure(Configure {
-        camera: good_cam,
-        tracker: params,
-        features_every: 0,
-        stats_every: 0,
-        search_evaluations_per_frame: default_search_evaluations(),
-        hypotheses: 1,
-        hypotheses_score_every: 1,
-        hypotheses_sample_iterations: 0,
-        hypotheses_other_iterations: 0,
-        hypotheses_keep_fingers: true,
-    }));
+    pipe.send(&HostMessage::Configure(Configure::new(good_cam, params)));
     let mut big = good_cam;
     big.width *= 2;
-    pipe.send(&HostMessage::Configure(Configure {
-        camera: big,
-        tracker: TrackerParams::default(),
-        features_every: 0,
-        stats_every: 0,
-        search_evaluations_per_frame: default_search_evaluations(),
-        hypotheses: 1,
-        hypotheses_score_every: 1,
-        hypotheses_sample_iterations: 0,
-        hypotheses_other_iterations: 0,
-        hypotheses_keep_fingers: true,
-    }));
+    pipe.send(&HostMessage::Configure(Configure::new(
+        big,
+        TrackerParams::default(),
+    )));
     pipe.send(&configure(0, 0));
     pipe.send(&HostMessage::Reset(Reset {
         q: q0[..7].iter().copied().collect(),

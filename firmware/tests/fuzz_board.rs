@@ -49,16 +49,12 @@ proptest! {
         let pixels = render(&model, &cam, &q0);
         let mut host = Pipe::default();
         host.send(&HostMessage::Configure(Configure {
-            camera: CameraParams::from_camera(&cam).unwrap(),
-            tracker: TrackerParams { iterations: 2, ..TrackerParams::default() },
             features_every: 1,
             stats_every: 1,
-            search_evaluations_per_frame: default_search_evaluations(),
-            hypotheses: 1,
-            hypotheses_score_every: 1,
-            hypotheses_sample_iterations: 0,
-            hypotheses_other_iterations: 0,
-            hypotheses_keep_fingers: true,
+            ..Configure::new(
+                CameraParams::from_camera(&cam).unwrap(),
+                TrackerParams { iterations: 2, ..TrackerParams::default() },
+            )
         }));
         host.send(&HostMessage::Reset(Reset { q: q0.iter().copied().collect(), free: 0b1111_0000, start: Start::Given }));
         for n in 0..3 {

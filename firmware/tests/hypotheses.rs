@@ -30,16 +30,14 @@ fn free_all(model: &Model) -> u32 {
 /// candidates weighed.
 fn configure_capped(hypotheses: u8, score_every: u8, caps: [u8; 2]) -> Configure {
     Configure {
-        camera: CameraParams::from_camera(&camera()).unwrap(),
-        tracker: TrackerParams::default(),
-        features_every: 0,
-        stats_every: 0,
-        search_evaluations_per_frame: default_search_evaluations(),
         hypotheses,
         hypotheses_score_every: score_every,
         hypotheses_sample_iterations: caps[0],
         hypotheses_other_iterations: caps[1],
-        hypotheses_keep_fingers: true,
+        ..Configure::new(
+            CameraParams::from_camera(&camera()).unwrap(),
+            TrackerParams::default(),
+        )
     }
 }
 

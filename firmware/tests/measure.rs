@@ -27,18 +27,10 @@ fn board(buffer: &mut [u8]) -> Board<'_, Pipe, Uploads, NoLed, StepClock> {
 }
 
 fn configure() -> HostMessage<'static> {
-    HostMessage::Configure(Configure {
-        camera: CameraParams::from_camera(&camera()).unwrap(),
-        tracker: TrackerParams::default(),
-        features_every: 0,
-        stats_every: 0,
-        search_evaluations_per_frame: default_search_evaluations(),
-        hypotheses: 1,
-        hypotheses_score_every: 1,
-        hypotheses_sample_iterations: 0,
-        hypotheses_other_iterations: 0,
-        hypotheses_keep_fingers: true,
-    })
+    HostMessage::Configure(Configure::new(
+        CameraParams::from_camera(&camera()).unwrap(),
+        TrackerParams::default(),
+    ))
 }
 
 fn measure(frame: u32, iteration: u8, q: &[f32]) -> HostMessage<'static> {

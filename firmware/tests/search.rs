@@ -30,19 +30,14 @@ fn free_mask() -> u32 {
 
 fn configure(iterations: u8, budget: u16) -> HostMessage<'static> {
     HostMessage::Configure(Configure {
-        camera: CameraParams::from_camera(&camera()).unwrap(),
-        tracker: TrackerParams {
-            iterations,
-            ..TrackerParams::default()
-        },
-        features_every: 0,
-        stats_every: 0,
         search_evaluations_per_frame: budget,
-        hypotheses: 1,
-        hypotheses_score_every: 1,
-        hypotheses_sample_iterations: 0,
-        hypotheses_other_iterations: 0,
-        hypotheses_keep_fingers: true,
+        ..Configure::new(
+            CameraParams::from_camera(&camera()).unwrap(),
+            TrackerParams {
+                iterations,
+                ..TrackerParams::default()
+            },
+        )
     })
 }
 

@@ -38,18 +38,12 @@ fn the_tap_sees_every_frame_of_a_pass_with_its_pixels_and_state() {
     );
     board.set_tap(&mut tap);
     board.start().unwrap();
-    board.serial_mut().send(&HostMessage::Configure(Configure {
-        camera: CameraParams::from_camera(&cam).unwrap(),
-        tracker: TrackerParams::default(),
-        features_every: 0,
-        stats_every: 0,
-        search_evaluations_per_frame: default_search_evaluations(),
-        hypotheses: 1,
-        hypotheses_score_every: 1,
-        hypotheses_sample_iterations: 0,
-        hypotheses_other_iterations: 0,
-        hypotheses_keep_fingers: true,
-    }));
+    board
+        .serial_mut()
+        .send(&HostMessage::Configure(Configure::new(
+            CameraParams::from_camera(&cam).unwrap(),
+            TrackerParams::default(),
+        )));
     board.serial_mut().send(&HostMessage::Reset(Reset {
         q: q0.iter().copied().collect(),
         free: [4u8, 5, 8, 9, 10, 19, 24].iter().map(|&s| 1u32 << s).sum(),

@@ -421,6 +421,27 @@ pub struct Configure {
     pub hypotheses_keep_fingers: bool,
 }
 
+impl Configure {
+    /// `camera` tracked under `tracker`, everything else as a host sends it by default: no
+    /// `Features` or `Stats` unasked, the search's budget, the tracker's own hypotheses (count,
+    /// scoring period, caps and finger-undo). Name the rest with struct update syntax.
+    pub fn new(camera: CameraParams, tracker: TrackerParams) -> Self {
+        let [sample_iterations, other_iterations] = default_hypotheses_iterations();
+        Configure {
+            camera,
+            tracker,
+            features_every: 0,
+            stats_every: 0,
+            search_evaluations_per_frame: default_search_evaluations(),
+            hypotheses: default_hypotheses(),
+            hypotheses_score_every: default_hypotheses_score_every(),
+            hypotheses_sample_iterations: sample_iterations,
+            hypotheses_other_iterations: other_iterations,
+            hypotheses_keep_fingers: default_hypotheses_keep_fingers(),
+        }
+    }
+}
+
 /// The search budget per frame a host sends by default: the search's own default.
 pub fn default_search_evaluations() -> u16 {
     AcquireConfig::default().evaluations_per_frame
