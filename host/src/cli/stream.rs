@@ -143,27 +143,9 @@ impl From<InitArg> for Start {
     }
 }
 
-/// The hypotheses' options of `stream`, apart from the rest (which `run` takes apart).
-#[derive(Clone, Copy)]
-struct HypothesesArgs {
-    hypotheses: Option<u8>,
-    score_every: Option<u8>,
-    hypothesis_budget: HypothesisBudgetArgs,
-}
-
-impl HypothesesArgs {
-    fn of(args: &StreamArgs) -> Self {
-        HypothesesArgs {
-            hypotheses: args.hypotheses,
-            score_every: args.score_every,
-            hypothesis_budget: args.hypothesis_budget,
-        }
-    }
-}
-
 /// Sets the board's hypotheses in `options` as `args` ask (count, scoring period, budget),
 /// refusing what means nothing with one hypothesis.
-fn apply_hypotheses(args: HypothesesArgs, options: &mut StreamOptions) -> Result<()> {
+fn apply_hypotheses(args: &StreamArgs, options: &mut StreamOptions) -> Result<()> {
     if let Some(k) = args.hypotheses {
         options.hypotheses = k;
     }
@@ -186,8 +168,7 @@ fn apply_hypotheses(args: HypothesesArgs, options: &mut StreamOptions) -> Result
 /// Streams to the board(s), writes the CSV and prints the summary; fails when no frame was
 /// tracked.
 pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
-    let hypotheses = HypothesesArgs::of(&args);
-    let port = args.port;
+    let port = &args.port;
     let tracker = TrackerParams::from_config(&tracker_config(args.iterations, false));
     if port.port.len() > 1 {
         let Some(seq) = args.seq else {
@@ -214,7 +195,7 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
         if args.camera_index.is_some() {
             bail!("--camera-index picks the one camera of a single board; with one --port per camera leave it out");
         }
-        let mut options = StereoOptions::new(port.port);
+        let mut options = StereoOptions::new(port.port.clone());
         options.baud = port.baud;
         options.reply_timeout = cli_values::duration(port.reply_timeout);
         options.tracker = tracker;
@@ -237,7 +218,7 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
     if let Some(n) = args.search_evaluations {
         options.search_evaluations_per_frame = n;
     }
-    apply_hypotheses(hypotheses, &mut options)?;
+    apply_hypotheses(&args, &mut options)?;
     let summary = match (args.seq, args.camera, args.setup) {
         (Some(seq), None, _) => stream_sequence(&seq, &args.out, &options)?,
         (None, Some(camera), Some(setup)) => {
@@ -265,7 +246,7 @@ mod tests {
         let base = ["stream", "--port", "/dev/null", "--seq", "seq"];
         let cli = Cli::try_parse_from([&base[..], args].concat())?;
         let mut options = StreamOptions::new("/dev/null");
-        apply_hypotheses(HypothesesArgs::of(&cli.stream), &mut options)?;
+        apply_hypotheses(&cli.stream, &mut options)?;
         Ok(options)
     }
 
