@@ -84,11 +84,13 @@ impl Owned {
                     features_every: 0,
                     stats_every: 0,
                     search_evaluations_per_frame: *budget,
-                    hypotheses: *hypotheses,
-                    hypotheses_score_every: *every,
-                    hypotheses_sample_iterations: caps[0],
-                    hypotheses_other_iterations: caps[1],
-                    hypotheses_keep_fingers: *keep,
+                    hypotheses: HypothesesParams {
+                        count: *hypotheses,
+                        score_every: *every,
+                        sample_iterations: caps[0],
+                        other_iterations: caps[1],
+                        keep_fingers: *keep,
+                    },
                 })
             }
         }

@@ -173,11 +173,13 @@ fn host_messages(data: &[u8]) -> std::vec::Vec<HostMessage<'_>> {
             features_every: u16::MAX,
             stats_every: u16::MAX,
             search_evaluations_per_frame: u16::MAX,
-            hypotheses: u8::MAX,
-            hypotheses_score_every: u8::MAX,
-            hypotheses_sample_iterations: u8::MAX,
-            hypotheses_other_iterations: u8::MAX,
-            hypotheses_keep_fingers: true,
+            hypotheses: HypothesesParams {
+                count: u8::MAX,
+                score_every: u8::MAX,
+                sample_iterations: u8::MAX,
+                other_iterations: u8::MAX,
+                keep_fingers: true,
+            },
         }),
         HostMessage::FrameChunk(FrameChunk {
             frame: u32::MAX,
@@ -515,7 +517,7 @@ fn hypothesis_counts_and_the_largest_hypotheses_message() {
     assert!((1..=MAX_HYPOTHESES as u8).all(hypotheses_in_range));
     assert!(!hypotheses_in_range(MAX_HYPOTHESES as u8 + 1));
     assert!(!hypotheses_in_range(u8::MAX));
-    assert!(hypotheses_in_range(default_hypotheses()));
+    assert!(hypotheses_in_range(HypothesesParams::default().count));
     let mut buf = [0u8; MAX_MESSAGE];
     let message = largest_hypotheses();
     let n = encode(&message, &mut buf).unwrap().len();
@@ -526,6 +528,49 @@ fn hypothesis_counts_and_the_largest_hypotheses_message() {
         unreachable!()
     };
     assert_eq!(h.hypotheses.len(), MAX_HYPOTHESES);
+}
+
+/// The hypotheses a host sends by default are the tracker's own, and applying them to the
+/// tracker's configuration changes nothing; every part of them reaches the configuration, and
+/// a board takes a count in 1..=MAX_HYPOTHESES scored at least one frame in 255.
+#[test]
+fn the_hypotheses_parameters_are_the_trackers_own_and_reach_its_configuration() {
+    use digiteyes_core::config::MAX_HYPOTHESES;
+    use digiteyes_core::hypotheses::HypothesesConfig;
+    let own = HypothesesConfig::default();
+    let defaults = HypothesesParams::default();
+    assert_eq!(defaults.over(own), own);
+    assert!(defaults.is_valid());
+    let asked = HypothesesParams {
+        count: 3,
+        score_every: 4,
+        sample_iterations: 1,
+        other_iterations: 2,
+        keep_fingers: !own.keep_fingers,
+    };
+    let expected = HypothesesConfig {
+        count: 3,
+        score_every_frames: 4,
+        sample_iterations: 1,
+        other_iterations: 2,
+        keep_fingers: !own.keep_fingers,
+        ..own
+    };
+    assert_eq!(asked.over(own), expected, "only the host's part changes");
+    for (count, score_every, valid) in [
+        (1, 1, true),
+        (MAX_HYPOTHESES as u8, 255, true),
+        (0, 1, false),
+        (MAX_HYPOTHESES as u8 + 1, 1, false),
+        (2, 0, false),
+    ] {
+        let params = HypothesesParams {
+            count,
+            score_every,
+            ..defaults
+        };
+        assert_eq!(params.is_valid(), valid, "{params:?}");
+    }
 }
 
 /// `Configure::new` is what a host sends when it names only the camera and the tracker: each
@@ -543,23 +588,8 @@ fn a_configure_with_the_defaults_names_only_the_camera_and_the_tracker() {
         configure.search_evaluations_per_frame,
         default_search_evaluations()
     );
-    assert_eq!(configure.hypotheses, default_hypotheses());
-    assert_eq!(
-        configure.hypotheses_score_every,
-        default_hypotheses_score_every()
-    );
-    assert_eq!(
-        [
-            configure.hypotheses_sample_iterations,
-            configure.hypotheses_other_iterations
-        ],
-        default_hypotheses_iterations()
-    );
-    assert_eq!(
-        configure.hypotheses_keep_fingers,
-        default_hypotheses_keep_fingers()
-    );
-    assert!(hypotheses_in_range(configure.hypotheses));
+    assert_eq!(configure.hypotheses, HypothesesParams::default());
+    assert!(configure.hypotheses.is_valid());
     let message = HostMessage::Configure(configure);
     let mut buf = [0u8; MAX_MESSAGE];
     let frame = encode(&message, &mut buf).unwrap();

@@ -41,11 +41,13 @@ fn host_messages(data: &[u8]) -> Vec<(&'static str, HostMessage<'_>)> {
                 features_every: 0,
                 stats_every: 30,
                 search_evaluations_per_frame: 1000,
-                hypotheses: 4,
-                hypotheses_score_every: 3,
-                hypotheses_sample_iterations: 2,
-                hypotheses_other_iterations: 1,
-                hypotheses_keep_fingers: false,
+                hypotheses: HypothesesParams {
+                    count: 4,
+                    score_every: 3,
+                    sample_iterations: 2,
+                    other_iterations: 1,
+                    keep_fingers: false,
+                },
             }),
         ),
         (

@@ -11,10 +11,9 @@ use digiteyes_core::hypotheses::HypothesesConfig;
 use digiteyes_core::measurement::measure_links;
 use digiteyes_core::model::Model;
 use digiteyes_core::protocol::{
-    encode, hypotheses_in_range, model_digest, BoardMessage, Capacities, Command, Configure,
-    Decoder, DropReason, Dropped, Features, FrameChunk, Hello, HostMessage, Hypotheses, Measure,
-    Measured, Refusal, Reset, Start, State, Stats, WireHypothesis, MAX_CHUNK, MAX_MESSAGE,
-    PROTOCOL_VERSION,
+    encode, model_digest, BoardMessage, Capacities, Command, Configure, Decoder, DropReason,
+    Dropped, Features, FrameChunk, Hello, HostMessage, Hypotheses, Measure, Measured, Refusal,
+    Reset, Start, State, Stats, WireHypothesis, MAX_CHUNK, MAX_MESSAGE, PROTOCOL_VERSION,
 };
 use digiteyes_core::remote::MeasureWork;
 use digiteyes_core::status::Status;
@@ -330,10 +329,7 @@ where
             .tracker
             .to_config()
             .map_err(|_| Refusal::BadParameters)?;
-        if configure.search_evaluations_per_frame == 0
-            || !hypotheses_in_range(configure.hypotheses)
-            || configure.hypotheses_score_every == 0
-        {
+        if configure.search_evaluations_per_frame == 0 || !configure.hypotheses.is_valid() {
             return Err(Refusal::BadParameters);
         }
         let acquire = search_config(configure.search_evaluations_per_frame);

@@ -37,25 +37,19 @@ pub fn search_config(evaluations_per_frame: u16) -> AcquireConfig {
     }
 }
 
-/// The hypotheses a board tracks: the tracker's defaults, as many as `Configure`'s
-/// `hypotheses`, scored one frame in its `hypotheses_score_every`, their iterations capped by
-/// its `hypotheses_sample_iterations` and `hypotheses_other_iterations`, the finger-undo
-/// candidates weighed as its `hypotheses_keep_fingers` says, their likelihood's
-/// edge map at [`SEARCH_STRIDE_PX`] so it fits the search's buffer ([`Buffers::edge_map`]).
+/// The hypotheses a board tracks: the tracker's defaults with `Configure`'s
+/// [`HypothesesParams`](digiteyes_core::protocol::HypothesesParams) in place, their
+/// likelihood's edge map at [`SEARCH_STRIDE_PX`] so it fits the search's buffer
+/// ([`Buffers::edge_map`]).
 pub fn hypotheses_config(configure: &Configure) -> HypothesesConfig {
     let defaults = HypothesesConfig::default();
-    HypothesesConfig {
-        count: configure.hypotheses,
-        score_every_frames: configure.hypotheses_score_every,
-        sample_iterations: configure.hypotheses_sample_iterations,
-        other_iterations: configure.hypotheses_other_iterations,
-        keep_fingers: configure.hypotheses_keep_fingers,
+    configure.hypotheses.over(HypothesesConfig {
         likelihood: LikelihoodConfig {
             stride_px: SEARCH_STRIDE_PX,
             ..defaults.likelihood
         },
         ..defaults
-    }
+    })
 }
 
 /// The caller-owned memory of a [`Board`](crate::Board), each part as long as the largest
@@ -75,7 +69,7 @@ pub struct Buffers<'m> {
 mod tests {
     use super::*;
     use digiteyes_core::likelihood::EdgeMap;
-    use digiteyes_core::protocol::{CameraParams, TrackerParams};
+    use digiteyes_core::protocol::{CameraParams, HypothesesParams, TrackerParams};
 
     /// A `Configure` asking for `count` hypotheses scored one frame in `score_every`, their
     /// iterations capped at `[sample, other]`, without the finger-undo candidates.
@@ -88,11 +82,13 @@ mod tests {
             t: [0.0, 0.0, 500.0],
         };
         Configure {
-            hypotheses: count,
-            hypotheses_score_every: score_every,
-            hypotheses_sample_iterations: iterations[0],
-            hypotheses_other_iterations: iterations[1],
-            hypotheses_keep_fingers: false,
+            hypotheses: HypothesesParams {
+                count,
+                score_every,
+                sample_iterations: iterations[0],
+                other_iterations: iterations[1],
+                keep_fingers: false,
+            },
             ..Configure::new(camera, TrackerParams::default())
         }
     }

@@ -30,10 +30,13 @@ fn free_all(model: &Model) -> u32 {
 /// candidates weighed.
 fn configure_capped(hypotheses: u8, score_every: u8, caps: [u8; 2]) -> Configure {
     Configure {
-        hypotheses,
-        hypotheses_score_every: score_every,
-        hypotheses_sample_iterations: caps[0],
-        hypotheses_other_iterations: caps[1],
+        hypotheses: HypothesesParams {
+            count: hypotheses,
+            score_every,
+            sample_iterations: caps[0],
+            other_iterations: caps[1],
+            ..HypothesesParams::default()
+        },
         ..Configure::new(
             CameraParams::from_camera(&camera()).unwrap(),
             TrackerParams::default(),
@@ -89,7 +92,7 @@ fn sequence(model: &Model) -> Vec<Vec<u8>> {
 /// report) and `Hypotheses` (scores, ages, states, best first) bit-equal. Returns the most
 /// hypotheses any frame carried.
 fn board_matches_in_process(wanted: Configure) -> usize {
-    let k = wanted.hypotheses;
+    let k = wanted.hypotheses.count;
     let model = Model::hand().unwrap();
     let q0 = pose(&model, 0.2);
     let free = free_all(&model);
@@ -246,10 +249,8 @@ fn a_board_with_capped_iterations_is_bit_equal_to_the_tracker_in_process() {
 
 #[test]
 fn a_board_without_the_finger_undo_is_bit_equal_to_the_tracker_in_process() {
-    let wanted = Configure {
-        hypotheses_keep_fingers: false,
-        ..configure_capped(2, 4, [2, 2])
-    };
+    let mut wanted = configure_capped(2, 4, [2, 2]);
+    wanted.hypotheses.keep_fingers = false;
     let most = board_matches_in_process(wanted);
     assert_eq!(most, 2, "two hypotheses were carried on some frame");
 }

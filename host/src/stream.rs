@@ -18,8 +18,7 @@ use std::time::Duration;
 
 use anyhow::{anyhow, ensure, Context, Result};
 use digiteyes_core::protocol::{
-    default_hypotheses, default_hypotheses_iterations, default_hypotheses_keep_fingers,
-    default_hypotheses_score_every, default_search_evaluations, Start, State, TrackerParams,
+    default_search_evaluations, HypothesesParams, Start, State, TrackerParams,
 };
 use digiteyes_core::status::Status;
 use digiteyes_core::tracker::FrameReport;
@@ -63,19 +62,9 @@ pub struct StreamOptions {
     pub start: Option<Start>,
     /// The board's search budget per frame, in evaluations (`Configure`).
     pub search_evaluations_per_frame: u16,
-    /// Hypotheses the board's tracker carries (`Configure`, 1..=8): more than 1 makes it
-    /// send them after every state; the summary counts them.
-    pub hypotheses: u8,
-    /// The hypotheses are scored one frame in this many (`Configure`, at least 1).
-    pub hypotheses_score_every: u8,
-    /// Gauss–Newton iterations at most for each new sample (`Configure`; 0: the tracker's
-    /// own).
-    pub hypotheses_sample_iterations: u8,
-    /// Gauss–Newton iterations at most for each carried hypothesis other than the best
-    /// (`Configure`; 0: the tracker's own).
-    pub hypotheses_other_iterations: u8,
-    /// Whether the finger-undo candidates are weighed (`Configure`).
-    pub hypotheses_keep_fingers: bool,
+    /// The hypotheses the board's tracker carries and what they may cost (`Configure`): more
+    /// than one makes it send them after every state; the summary counts them.
+    pub hypotheses: HypothesesParams,
     /// Show a progress bar (when stderr is a terminal).
     pub progress: bool,
 }
@@ -91,11 +80,7 @@ impl StreamOptions {
             tracker: TrackerParams::default(),
             start: None,
             search_evaluations_per_frame: default_search_evaluations(),
-            hypotheses: default_hypotheses(),
-            hypotheses_score_every: default_hypotheses_score_every(),
-            hypotheses_sample_iterations: default_hypotheses_iterations()[0],
-            hypotheses_other_iterations: default_hypotheses_iterations()[1],
-            hypotheses_keep_fingers: default_hypotheses_keep_fingers(),
+            hypotheses: HypothesesParams::default(),
             progress: false,
         }
     }
@@ -372,10 +357,6 @@ fn connect(sequence: &Sequence, options: &StreamOptions) -> Result<Session> {
     }
     setup.search_evaluations_per_frame = options.search_evaluations_per_frame;
     setup.hypotheses = options.hypotheses;
-    setup.hypotheses_score_every = options.hypotheses_score_every;
-    setup.hypotheses_sample_iterations = options.hypotheses_sample_iterations;
-    setup.hypotheses_other_iterations = options.hypotheses_other_iterations;
-    setup.hypotheses_keep_fingers = options.hypotheses_keep_fingers;
     setup.reply_timeout = options.reply_timeout;
     let link = Link::open(&options.port, options.baud)?;
     Session::start(link, setup)

@@ -391,34 +391,76 @@ pub struct Configure {
     /// [`default_search_evaluations`]): a searching board answers every frame after at most
     /// this much search work (and the one hypothesis under way).
     pub search_evaluations_per_frame: u16,
-    /// Hypotheses the tracker carries between frames, 1..=[`MAX_HYPOTHESES`] (version 5;
-    /// `hypotheses::HypothesesConfig::count`; default [`default_hypotheses`]): 1 is the
-    /// single tracker, bit for bit; more make the board send [`BoardMessage::Hypotheses`]
-    /// after every `State`. 0 or more than [`MAX_HYPOTHESES`] is refused
-    /// (`Nak(Configure, BadParameters)`).
-    pub hypotheses: u8,
+    /// The hypotheses the tracker carries and what they may cost (versions 5, 9 and 10; on
+    /// the wire, its fields in order, as if they were `Configure`'s own).
+    pub hypotheses: HypothesesParams,
+}
+
+/// How many hypotheses a board's tracker carries and what the ones other than the best may
+/// cost: the part of [`hypotheses::HypothesesConfig`](HypothesesConfig) a host chooses. Its
+/// [`Default`] is the tracker's own.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct HypothesesParams {
+    /// Hypotheses carried between frames, 1..=[`MAX_HYPOTHESES`] (version 5;
+    /// `HypothesesConfig::count`): 1 is the single tracker, bit for bit; more make the board
+    /// send [`BoardMessage::Hypotheses`] after every `State`. 0 or more than
+    /// [`MAX_HYPOTHESES`] is refused (`Nak(Configure, BadParameters)`).
+    pub count: u8,
     /// With more than one hypothesis, they are scored, sampled around and merged on one frame
-    /// in this many, at least 1 (version 9; `hypotheses::HypothesesConfig::score_every_frames`;
-    /// default [`default_hypotheses_score_every`], every frame): the rest of K > 1's cost is
-    /// paid on those frames only, so a board can keep its frame rate with K = 2
-    /// (docs/hypotheses.md, "Scoring one frame in S"). 0 is refused
+    /// in this many, at least 1 (version 9; `HypothesesConfig::score_every_frames`; default
+    /// every frame): the rest of K > 1's cost is paid on those frames only, so a board can keep
+    /// its frame rate with K = 2 (docs/hypotheses.md, "Scoring one frame in S"). 0 is refused
     /// (`Nak(Configure, BadParameters)`); with one hypothesis it changes nothing.
-    pub hypotheses_score_every: u8,
+    pub score_every: u8,
     /// Gauss–Newton iterations at most for each new sample on the frame it is drawn (version
-    /// 10; `hypotheses::HypothesesConfig::sample_iterations`; 0, the default: the tracker's
-    /// own number, as is any number at or above it). With one hypothesis it changes nothing.
-    pub hypotheses_sample_iterations: u8,
+    /// 10; `HypothesesConfig::sample_iterations`; 0, the default: the tracker's own number, as
+    /// is any number at or above it). With one hypothesis it changes nothing.
+    pub sample_iterations: u8,
     /// Gauss–Newton iterations at most for each carried hypothesis other than the best
-    /// (version 10; `hypotheses::HypothesesConfig::other_iterations`; 0, the default: the
-    /// tracker's own). The best always takes the tracker's own number. With both caps at 2,
-    /// K = 4 scored one frame in 4 costs a 480 MHz M7 about 23 ms a frame on the mean
-    /// (docs/hypotheses.md, "Fewer iterations for the hypotheses other than the best").
-    pub hypotheses_other_iterations: u8,
+    /// (version 10; `HypothesesConfig::other_iterations`; 0, the default: the tracker's own).
+    /// The best always takes the tracker's own number. With both caps at 2, K = 4 scored one
+    /// frame in 4 costs a 480 MHz M7 about 23 ms a frame on the mean (docs/hypotheses.md,
+    /// "Fewer iterations for the hypotheses other than the best").
+    pub other_iterations: u8,
     /// Whether each scored frame also weighs the best with each finger's update undone and
-    /// with every finger's undone (version 10; `hypotheses::HypothesesConfig::keep_fingers`;
-    /// default [`default_hypotheses_keep_fingers`], true). Off saves up to six candidates'
-    /// scores a scored frame (docs/hypotheses.md, "Two hypotheses within a board's frame budget").
-    pub hypotheses_keep_fingers: bool,
+    /// with every finger's undone (version 10; `HypothesesConfig::keep_fingers`; default true).
+    /// Off saves up to six candidates' scores a scored frame (docs/hypotheses.md, "Two
+    /// hypotheses within a board's frame budget").
+    pub keep_fingers: bool,
+}
+
+impl Default for HypothesesParams {
+    fn default() -> Self {
+        let own = HypothesesConfig::default();
+        HypothesesParams {
+            count: own.count,
+            score_every: own.score_every_frames.max(1),
+            sample_iterations: own.sample_iterations,
+            other_iterations: own.other_iterations,
+            keep_fingers: own.keep_fingers,
+        }
+    }
+}
+
+impl HypothesesParams {
+    /// Whether a board takes these: a count in 1..=[`MAX_HYPOTHESES`] and a scoring period of
+    /// at least 1 (the caps take any value).
+    pub fn is_valid(&self) -> bool {
+        hypotheses_in_range(self.count) && self.score_every >= 1
+    }
+
+    /// `base` with these parameters in place of its own (the rest of `base` kept).
+    pub fn over(&self, base: HypothesesConfig) -> HypothesesConfig {
+        HypothesesConfig {
+            count: self.count,
+            score_every_frames: self.score_every,
+            sample_iterations: self.sample_iterations,
+            other_iterations: self.other_iterations,
+            keep_fingers: self.keep_fingers,
+            ..base
+        }
+    }
 }
 
 impl Configure {
@@ -426,18 +468,13 @@ impl Configure {
     /// `Features` or `Stats` unasked, the search's budget, the tracker's own hypotheses (count,
     /// scoring period, caps and finger-undo). Name the rest with struct update syntax.
     pub fn new(camera: CameraParams, tracker: TrackerParams) -> Self {
-        let [sample_iterations, other_iterations] = default_hypotheses_iterations();
         Configure {
             camera,
             tracker,
             features_every: 0,
             stats_every: 0,
             search_evaluations_per_frame: default_search_evaluations(),
-            hypotheses: default_hypotheses(),
-            hypotheses_score_every: default_hypotheses_score_every(),
-            hypotheses_sample_iterations: sample_iterations,
-            hypotheses_other_iterations: other_iterations,
-            hypotheses_keep_fingers: default_hypotheses_keep_fingers(),
+            hypotheses: HypothesesParams::default(),
         }
     }
 }
@@ -445,29 +482,6 @@ impl Configure {
 /// The search budget per frame a host sends by default: the search's own default.
 pub fn default_search_evaluations() -> u16 {
     AcquireConfig::default().evaluations_per_frame
-}
-
-/// The hypothesis count a host sends by default: the tracker's own default.
-pub fn default_hypotheses() -> u8 {
-    HypothesesConfig::default().count
-}
-
-/// How often a host asks the hypotheses scored by default: the tracker's own default.
-pub fn default_hypotheses_score_every() -> u8 {
-    HypothesesConfig::default().score_every_frames.max(1)
-}
-
-/// The caps on the hypotheses' iterations a host sends by default, `[sample, other]`: the
-/// tracker's own defaults (0: uncapped).
-pub fn default_hypotheses_iterations() -> [u8; 2] {
-    let defaults = HypothesesConfig::default();
-    [defaults.sample_iterations, defaults.other_iterations]
-}
-
-/// Whether a host asks the finger-undo candidates weighed by default: the tracker's own
-/// default.
-pub fn default_hypotheses_keep_fingers() -> bool {
-    HypothesesConfig::default().keep_fingers
 }
 
 /// Whether `count` is a hypothesis count a board takes: 1..=[`MAX_HYPOTHESES`].

@@ -46,7 +46,8 @@ pub use params::{BadParameter, CameraParams, TrackerParams, WireResidual, WireRo
 /// Version 10: `Configure` gained `hypotheses_sample_iterations` and
 /// `hypotheses_other_iterations`, caps on the Gauss–Newton iterations of the hypotheses other
 /// than the best, and `hypotheses_keep_fingers`, whether the finger-undo candidates are weighed
-/// (issue 11; docs/protocol.md §11).
+/// (issue 11; docs/protocol.md §11). Since grouped, with versions 5 and 9's fields, into
+/// `Configure.hypotheses` ([`HypothesesParams`]): the same bytes, so the same version.
 pub const PROTOCOL_VERSION: u8 = 10;
 
 /// Largest `FrameChunk` payload (bytes).

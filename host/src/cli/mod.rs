@@ -5,7 +5,7 @@
 pub mod bench;
 pub mod demo;
 pub mod eval;
-pub mod hypothesis_budget;
+pub mod hypotheses;
 pub mod listen;
 pub mod render;
 pub mod report;

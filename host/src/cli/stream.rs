@@ -7,7 +7,7 @@ use clap::{Args, ValueEnum};
 use digiteyes_core::config::MAX_HYPOTHESES;
 use digiteyes_core::protocol::{Start, TrackerParams};
 
-use super::hypothesis_budget::HypothesisBudgetArgs;
+use super::hypotheses::{self, HypothesisBudgetArgs};
 use super::tracker_config;
 use crate::cli_values;
 use crate::stereo::{stream_stereo, StereoOptions};
@@ -143,26 +143,28 @@ impl From<InitArg> for Start {
     }
 }
 
-/// Sets the board's hypotheses in `options` as `args` ask (count, scoring period, budget),
-/// refusing what means nothing with one hypothesis.
-fn apply_hypotheses(args: &StreamArgs, options: &mut StreamOptions) -> Result<()> {
-    if let Some(k) = args.hypotheses {
-        options.hypotheses = k;
+/// What a single board is told, as `args` ask: the port, the tracker, how to start, the
+/// search's budget and the hypotheses. Refuses hypotheses' options that mean nothing with one.
+fn single_board_options(
+    args: &StreamArgs,
+    tracker: TrackerParams,
+    progress: bool,
+) -> Result<StreamOptions> {
+    let port = &args.port;
+    let port_path = port.port.first().cloned().unwrap_or_default();
+    let mut options = StreamOptions::new(&port_path)
+        .baud(port.baud)
+        .reply_timeout(cli_values::duration(port.reply_timeout))
+        .camera_index(args.camera_index)
+        .start(args.init.map(Start::from))
+        .progress(progress && !args.quiet);
+    options.tracker = tracker;
+    if let Some(n) = args.search_evaluations {
+        options.search_evaluations_per_frame = n;
     }
-    if let Some(s) = args.score_every {
-        super::track::check_score_every(options.hypotheses, s)?;
-        options.hypotheses_score_every = s;
-    }
-    let budget = args.hypothesis_budget;
-    budget.check(options.hypotheses)?;
-    if let Some(n) = budget.sample_iterations {
-        options.hypotheses_sample_iterations = n;
-    }
-    if let Some(n) = budget.other_iterations {
-        options.hypotheses_other_iterations = n;
-    }
-    options.hypotheses_keep_fingers &= !budget.no_keep_fingers;
-    Ok(())
+    options.hypotheses =
+        hypotheses::asked(args.hypotheses, args.score_every, &args.hypothesis_budget)?;
+    Ok(options)
 }
 
 /// Streams to the board(s), writes the CSV and prints the summary; fails when no frame was
@@ -207,18 +209,7 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
         }
         return Ok(());
     }
-    let port_path = port.port.first().cloned().unwrap_or_default();
-    let mut options = StreamOptions::new(&port_path)
-        .baud(port.baud)
-        .reply_timeout(cli_values::duration(port.reply_timeout))
-        .camera_index(args.camera_index)
-        .start(args.init.map(Start::from))
-        .progress(progress && !args.quiet);
-    options.tracker = tracker;
-    if let Some(n) = args.search_evaluations {
-        options.search_evaluations_per_frame = n;
-    }
-    apply_hypotheses(&args, &mut options)?;
+    let options = single_board_options(&args, tracker, progress)?;
     let summary = match (args.seq, args.camera, args.setup) {
         (Some(seq), None, _) => stream_sequence(&seq, &args.out, &options)?,
         (None, Some(camera), Some(setup)) => {
@@ -234,7 +225,7 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
 mod tests {
     use super::*;
     use clap::Parser;
-    use digiteyes_core::protocol::default_hypotheses;
+    use digiteyes_core::protocol::HypothesesParams;
 
     #[derive(Parser)]
     struct Cli {
@@ -245,9 +236,7 @@ mod tests {
     fn options(args: &[&str]) -> Result<StreamOptions> {
         let base = ["stream", "--port", "/dev/null", "--seq", "seq"];
         let cli = Cli::try_parse_from([&base[..], args].concat())?;
-        let mut options = StreamOptions::new("/dev/null");
-        apply_hypotheses(&cli.stream, &mut options)?;
-        Ok(options)
+        single_board_options(&cli.stream, TrackerParams::default(), false)
     }
 
     /// What `Configure` then carries: the hypotheses' count, scoring period and budget as
@@ -255,14 +244,16 @@ mod tests {
     #[test]
     fn the_hypotheses_options_reach_what_the_board_is_configured_with() {
         let defaults = options(&[]).unwrap();
-        assert_eq!(defaults.hypotheses, default_hypotheses());
-        assert!(defaults.hypotheses_keep_fingers);
+        assert_eq!(defaults.hypotheses, HypothesesParams::default());
         assert_eq!(
             (
-                defaults.hypotheses_sample_iterations,
-                defaults.hypotheses_other_iterations
+                defaults.port.as_str(),
+                defaults.search_evaluations_per_frame
             ),
-            (0, 0)
+            (
+                "/dev/null",
+                StreamOptions::new("x").search_evaluations_per_frame
+            )
         );
         let asked = options(&[
             "--hypotheses",
@@ -274,18 +265,21 @@ mod tests {
             "--other-iterations",
             "3",
             "--no-keep-fingers",
+            "--search-evaluations",
+            "7",
         ])
         .unwrap();
         assert_eq!(
-            (
-                asked.hypotheses,
-                asked.hypotheses_score_every,
-                asked.hypotheses_sample_iterations,
-                asked.hypotheses_other_iterations,
-                asked.hypotheses_keep_fingers
-            ),
-            (2, 4, 2, 3, false)
+            asked.hypotheses,
+            HypothesesParams {
+                count: 2,
+                score_every: 4,
+                sample_iterations: 2,
+                other_iterations: 3,
+                keep_fingers: false,
+            }
         );
+        assert_eq!(asked.search_evaluations_per_frame, 7);
         let err = options(&["--no-keep-fingers"]).unwrap_err().to_string();
         assert!(err.contains("--no-keep-fingers"), "{err}");
     }

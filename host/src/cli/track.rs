@@ -2,10 +2,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::{Args, ValueEnum};
 
-use super::hypothesis_budget::HypothesisBudgetArgs;
+use super::hypotheses::{self, HypothesisBudgetArgs};
 use super::tracker_config;
 use crate::acquire::Recovery;
 use crate::track::{track_sequence_to, Init, TrackOptions, TrackOutputs};
@@ -94,17 +94,6 @@ pub struct TrackArgs {
     pub hypothesis_budget: HypothesisBudgetArgs,
 }
 
-/// Refuses `--score-every` above 1 for a single hypothesis, where it would change nothing.
-pub fn check_score_every(hypotheses: u8, score_every: u8) -> Result<()> {
-    if score_every > 1 && hypotheses <= 1 {
-        bail!(
-            "--score-every {score_every}: only several hypotheses are scored; give \
-             --hypotheses K with K > 1, or leave --score-every out"
-        );
-    }
-    Ok(())
-}
-
 /// `--hypotheses`' values: a whole number 1..=MAX_HYPOTHESES.
 fn hypotheses_count(text: &str) -> Result<u8, String> {
     let max = digiteyes_core::config::MAX_HYPOTHESES;
@@ -135,8 +124,11 @@ pub enum RecoverArg {
 
 /// Tracks the sequence and prints the summary; `progress`: a progress bar on stderr.
 pub fn run(args: TrackArgs, progress: bool) -> Result<()> {
-    check_score_every(args.hypotheses, args.score_every)?;
-    args.hypothesis_budget.check(args.hypotheses)?;
+    let asked = hypotheses::asked(
+        Some(args.hypotheses),
+        Some(args.score_every),
+        &args.hypothesis_budget,
+    )?;
     let config = tracker_config(args.iterations, args.no_predict);
     let options = TrackOptions {
         init: args.init.map(|i| match i {
@@ -147,11 +139,7 @@ pub fn run(args: TrackArgs, progress: bool) -> Result<()> {
             RecoverArg::Search => Recovery::Search,
             RecoverArg::Never => Recovery::Never,
         },
-        hypotheses: args.hypothesis_budget.applied(HypothesesConfig {
-            count: args.hypotheses,
-            score_every_frames: args.score_every,
-            ..HypothesesConfig::default()
-        }),
+        hypotheses: asked.over(HypothesesConfig::default()),
         ..TrackOptions::default()
     };
     let outputs = TrackOutputs {

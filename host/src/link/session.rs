@@ -304,10 +304,6 @@ impl Session {
             stats_every: self.setup.stats_every,
             search_evaluations_per_frame: self.setup.search_evaluations_per_frame,
             hypotheses: self.setup.hypotheses,
-            hypotheses_score_every: self.setup.hypotheses_score_every,
-            hypotheses_sample_iterations: self.setup.hypotheses_sample_iterations,
-            hypotheses_other_iterations: self.setup.hypotheses_other_iterations,
-            hypotheses_keep_fingers: self.setup.hypotheses_keep_fingers,
         });
         self.command(&configure, Command::Configure)?;
         // A search starts from the same base as the host's own (`track --init auto`).

@@ -5,9 +5,7 @@ use std::time::Duration;
 
 use anyhow::{anyhow, bail, Result};
 use digiteyes_core::protocol::{
-    default_hypotheses, default_hypotheses_iterations, default_hypotheses_keep_fingers,
-    default_hypotheses_score_every, default_search_evaluations, model_digest, CameraParams, Start,
-    TrackerParams,
+    default_search_evaluations, model_digest, CameraParams, HypothesesParams, Start, TrackerParams,
 };
 
 use crate::sequence::Sequence;
@@ -40,20 +38,10 @@ pub struct SessionSetup {
     pub start: Start,
     /// The board's search budget per frame, in evaluations (`Configure`).
     pub search_evaluations_per_frame: u16,
-    /// Hypotheses the board's tracker carries, 1..=8 (`Configure`; protocol version 5): more
-    /// than 1 makes it send a `Hypotheses` message after every `State`.
-    pub hypotheses: u8,
-    /// The hypotheses are scored one frame in this many, at least 1 (`Configure`; protocol
-    /// version 9).
-    pub hypotheses_score_every: u8,
-    /// Gauss–Newton iterations at most for each new sample, 0: the tracker's own
-    /// (`Configure`; protocol version 10).
-    pub hypotheses_sample_iterations: u8,
-    /// Gauss–Newton iterations at most for each carried hypothesis other than the best, 0: the
-    /// tracker's own (`Configure`; protocol version 10).
-    pub hypotheses_other_iterations: u8,
-    /// Whether the finger-undo candidates are weighed (`Configure`; protocol version 10).
-    pub hypotheses_keep_fingers: bool,
+    /// The hypotheses the board's tracker carries and what they may cost (`Configure`;
+    /// protocol versions 5, 9 and 10): more than one makes it send a `Hypotheses` message
+    /// after every `State`.
+    pub hypotheses: HypothesesParams,
     /// [`model_digest`] of the model the frames show; the board's must match.
     pub model_digest: u32,
     /// The model's name for messages (`sequence.json`'s `model`).
@@ -110,11 +98,7 @@ impl SessionSetup {
                 Start::Search
             },
             search_evaluations_per_frame: default_search_evaluations(),
-            hypotheses: default_hypotheses(),
-            hypotheses_score_every: default_hypotheses_score_every(),
-            hypotheses_sample_iterations: default_hypotheses_iterations()[0],
-            hypotheses_other_iterations: default_hypotheses_iterations()[1],
-            hypotheses_keep_fingers: default_hypotheses_keep_fingers(),
+            hypotheses: HypothesesParams::default(),
             model_digest: model_digest(&sequence.model),
             model_name: sequence.file.model.clone(),
             reply_timeout: DEFAULT_REPLY_TIMEOUT,

@@ -1,11 +1,46 @@
-//! What the hypotheses other than the best may cost, as options shared by `track` and
-//! `stream`: caps on their Gauss–Newton iterations (`--sample-iterations`,
-//! `--other-iterations`) and the finger-undo candidates (`--no-keep-fingers`).
+//! The hypotheses `track` and `stream` ask for, from their options: the count
+//! (`--hypotheses`), the scoring period (`--score-every`), and what the hypotheses other than
+//! the best may cost — caps on their Gauss–Newton iterations (`--sample-iterations`,
+//! `--other-iterations`) and the finger-undo candidates (`--no-keep-fingers`). Both commands
+//! map them to one [`HypothesesParams`]: `track` lays it over the tracker's configuration,
+//! `stream` sends it in `Configure`.
 
 use anyhow::{bail, Result};
 use clap::Args;
 
-use digiteyes_core::hypotheses::HypothesesConfig;
+use digiteyes_core::protocol::HypothesesParams;
+
+/// The hypotheses asked for: `count` (left out: the default), scored one frame in
+/// `score_every` (left out: the default), under `budget`. Refuses a scoring period or a budget
+/// for a single hypothesis, where either would change nothing.
+pub fn asked(
+    count: Option<u8>,
+    score_every: Option<u8>,
+    budget: &HypothesisBudgetArgs,
+) -> Result<HypothesesParams> {
+    let defaults = HypothesesParams::default();
+    let count = count.unwrap_or(defaults.count);
+    if let Some(s) = score_every {
+        check_score_every(count, s)?;
+    }
+    budget.check(count)?;
+    Ok(budget.applied(HypothesesParams {
+        count,
+        score_every: score_every.unwrap_or(defaults.score_every),
+        ..defaults
+    }))
+}
+
+/// Refuses `--score-every` above 1 for a single hypothesis, where it would change nothing.
+fn check_score_every(hypotheses: u8, score_every: u8) -> Result<()> {
+    if score_every > 1 && hypotheses <= 1 {
+        bail!(
+            "--score-every {score_every}: only several hypotheses are scored; give \
+             --hypotheses K with K > 1, or leave --score-every out"
+        );
+    }
+    Ok(())
+}
 
 /// The hypotheses' budget as options (each left out: the tracker's default).
 #[derive(Args, Debug, Clone, Copy, Default)]
@@ -32,7 +67,7 @@ pub struct HypothesisBudgetArgs {
 
 impl HypothesisBudgetArgs {
     /// Refuses any of these options for a single hypothesis, where it would change nothing.
-    pub fn check(&self, hypotheses: u8) -> Result<()> {
+    fn check(&self, hypotheses: u8) -> Result<()> {
         if hypotheses > 1 {
             return Ok(());
         }
@@ -66,14 +101,13 @@ impl HypothesisBudgetArgs {
         self.sample_iterations.is_some() || self.other_iterations.is_some() || self.no_keep_fingers
     }
 
-    /// `config` with these options applied (the caps: 0, the tracker's own number, when left
-    /// out).
-    pub fn applied(&self, config: HypothesesConfig) -> HypothesesConfig {
-        HypothesesConfig {
-            sample_iterations: self.sample_iterations.unwrap_or(config.sample_iterations),
-            other_iterations: self.other_iterations.unwrap_or(config.other_iterations),
-            keep_fingers: config.keep_fingers && !self.no_keep_fingers,
-            ..config
+    /// `params` with these options applied (each left out: as in `params`).
+    fn applied(&self, params: HypothesesParams) -> HypothesesParams {
+        HypothesesParams {
+            sample_iterations: self.sample_iterations.unwrap_or(params.sample_iterations),
+            other_iterations: self.other_iterations.unwrap_or(params.other_iterations),
+            keep_fingers: params.keep_fingers && !self.no_keep_fingers,
+            ..params
         }
     }
 }
@@ -87,33 +121,35 @@ mod tests {
         let none = HypothesisBudgetArgs::default();
         assert!(!none.any());
         assert_eq!(
-            none.applied(HypothesesConfig::default()),
-            HypothesesConfig::default()
+            asked(None, None, &none).unwrap(),
+            HypothesesParams::default()
         );
-        assert!(none.check(1).is_ok());
+        assert!(asked(Some(1), Some(1), &none).is_ok());
         let all = HypothesisBudgetArgs {
             sample_iterations: Some(2),
             other_iterations: Some(3),
             no_keep_fingers: true,
         };
-        let applied = all.applied(HypothesesConfig::default());
         assert_eq!(
-            (
-                applied.sample_iterations,
-                applied.other_iterations,
-                applied.keep_fingers
-            ),
-            (2, 3, false)
+            asked(Some(4), Some(5), &all).unwrap(),
+            HypothesesParams {
+                count: 4,
+                score_every: 5,
+                sample_iterations: 2,
+                other_iterations: 3,
+                keep_fingers: false,
+            }
         );
-        assert!(all.check(4).is_ok());
-        let err = all.check(1).unwrap_err().to_string();
+        let err = asked(Some(1), None, &all).unwrap_err().to_string();
         assert!(err.starts_with("--sample-iterations 2:"), "{err}");
+        let err = asked(None, Some(2), &none).unwrap_err().to_string();
+        assert!(err.starts_with("--score-every 2:"), "{err}");
         let undo_only = HypothesisBudgetArgs {
             no_keep_fingers: true,
             ..HypothesisBudgetArgs::default()
         };
         assert!(undo_only.any());
-        let err = undo_only.check(1).unwrap_err().to_string();
+        let err = asked(Some(1), Some(1), &undo_only).unwrap_err().to_string();
         assert!(err.starts_with("--no-keep-fingers:"), "{err}");
     }
 }
