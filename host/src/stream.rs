@@ -18,7 +18,7 @@ use std::time::Duration;
 
 use anyhow::{anyhow, ensure, Context, Result};
 use digiteyes_core::protocol::{
-    default_search_evaluations, HypothesesParams, Start, State, TrackerParams,
+    default_search_evaluations, Hypotheses, HypothesesParams, Start, State, TrackerParams,
 };
 use digiteyes_core::status::Status;
 use digiteyes_core::tracker::FrameReport;
@@ -27,6 +27,7 @@ use digiteyes_platform_linux::camera::V4l2Camera;
 use crate::link::{
     DropCause, FrameOutcome, Link, LinkReport, Session, SessionSetup, DEFAULT_REPLY_TIMEOUT,
 };
+use crate::sequence::hypotheses::HypothesesWriter;
 use crate::sequence::{Sequence, StatesWriter};
 
 /// The column `stream` adds after `track`'s: why a frame was not tracked.
@@ -65,6 +66,10 @@ pub struct StreamOptions {
     /// The hypotheses the board's tracker carries and what they may cost (`Configure`): more
     /// than one makes it send them after every state; the summary counts them.
     pub hypotheses: HypothesesParams,
+    /// Where to write every hypothesis the board sends, frame by frame, as `track
+    /// --hypotheses-out` writes the tracker's own ([`crate::sequence::hypotheses`]); `None`:
+    /// only counted.
+    pub hypotheses_out: Option<PathBuf>,
     /// Show a progress bar (when stderr is a terminal).
     pub progress: bool,
 }
@@ -81,6 +86,7 @@ impl StreamOptions {
             start: None,
             search_evaluations_per_frame: default_search_evaluations(),
             hypotheses: HypothesesParams::default(),
+            hypotheses_out: None,
             progress: false,
         }
     }
@@ -132,6 +138,9 @@ pub struct StreamSummary {
     pub link: LinkReport,
     /// Ticks per second of the board's clock (`Hello::clock_hz`), the unit of `track_ticks`.
     pub board_clock_hz: u32,
+    /// Where the board's hypotheses were written, the rows written, and the messages left out
+    /// because their frame did not follow the last one written (none from a working board).
+    pub hypotheses_out: Option<(PathBuf, usize, usize)>,
 }
 
 impl StreamSummary {
@@ -277,6 +286,13 @@ impl fmt::Display for StreamSummary {
             writeln!(f)?;
         }
         writeln!(f, "states written to {}", self.out.display())?;
+        if let Some((path, rows, skipped)) = &self.hypotheses_out {
+            write!(f, "hypotheses: {rows} row(s) written to {}", path.display())?;
+            if *skipped > 0 {
+                write!(f, " ({skipped} message(s) out of frame order left out)")?;
+            }
+            writeln!(f)?;
+        }
         if let Some(work) = self.board_work() {
             writeln!(f, "{work}")?;
         }
@@ -377,6 +393,17 @@ fn run(
         sequence.n_states(),
         &[DROPPED_COLUMN, STATUS_COLUMN, BOARD_TICKS_COLUMN],
     )?;
+    let mut hypotheses = match &options.hypotheses_out {
+        Some(path) => {
+            session.keep_hypotheses();
+            Some(BoardHypotheses {
+                writer: HypothesesWriter::create(path, sequence.n_states())?,
+                next_frame: 0,
+                skipped: 0,
+            })
+        }
+        None => None,
+    };
     let bar = crate::progress::bar(expected, "stream", options.progress);
     let mut last: Vec<f32> = sequence.initial_state.iter().map(|&v| v as f32).collect();
     let mut outcomes = Vec::with_capacity(expected);
@@ -412,11 +439,22 @@ fn run(
             }
         }
         outcomes.push(outcome);
+        if let Some(out) = hypotheses.as_mut() {
+            out.write(session.take_hypotheses())?;
+        }
         bar.inc(1);
     }
     bar.finish_and_clear();
     let frames = writer.finish()?;
     let link = session.finish()?;
+    let hypotheses_out = match (hypotheses, &options.hypotheses_out) {
+        (Some(mut out), Some(path)) => {
+            // The last frame's message came while `finish` awaited its answer.
+            out.write(session.take_hypotheses())?;
+            Some((path.clone(), out.writer.finish()?, out.skipped))
+        }
+        _ => None,
+    };
     let board_clock_hz = session.hello().clock_hz;
     Ok(StreamSummary {
         frames,
@@ -425,7 +463,32 @@ fn run(
         out: out_csv.to_path_buf(),
         link,
         board_clock_hz,
+        hypotheses_out,
     })
+}
+
+/// The board's hypotheses on their way to the file: each message's rows, frames ascending.
+struct BoardHypotheses {
+    writer: HypothesesWriter,
+    /// The first frame a message may be written for (frames ascend in the file).
+    next_frame: u64,
+    /// Messages left out because their frame did not follow the last one written.
+    skipped: usize,
+}
+
+impl BoardHypotheses {
+    fn write(&mut self, messages: Vec<Hypotheses>) -> Result<()> {
+        for message in messages {
+            let frame = u64::from(message.frame);
+            if frame < self.next_frame {
+                self.skipped += 1;
+                continue;
+            }
+            self.writer.write_message(&message)?;
+            self.next_frame = frame + 1;
+        }
+        Ok(())
+    }
 }
 
 /// The tracker's report as the board sent it (`lost` whenever the board claims no hand).
@@ -465,6 +528,44 @@ mod tests {
         })
     }
 
+    /// Messages are written as they come while their frames ascend; one whose frame does not
+    /// follow the last written is left out and counted, not written out of order.
+    #[test]
+    fn the_boards_hypotheses_are_written_in_frame_order_only() {
+        use digiteyes_core::protocol::WireHypothesis;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("hyp.csv");
+        let message = |frame: u32, count: usize| Hypotheses {
+            frame,
+            hypotheses: (0..count)
+                .map(|i| WireHypothesis {
+                    score: 0.5,
+                    age: i as u32,
+                    q: [1.0, 0.0, 0.0, 0.0, frame as f32].into_iter().collect(),
+                })
+                .collect(),
+        };
+        let mut out = BoardHypotheses {
+            writer: HypothesesWriter::create(&path, 5).unwrap(),
+            next_frame: 0,
+            skipped: 0,
+        };
+        out.write(vec![message(0, 2), message(2, 1)]).unwrap();
+        out.write(vec![
+            message(2, 3),
+            message(1, 1),
+            message(3, 0),
+            message(4, 1),
+        ])
+        .unwrap();
+        assert_eq!(out.skipped, 2);
+        assert_eq!(out.writer.finish().unwrap(), 4);
+        let table = crate::sequence::hypotheses::read_hypotheses(&path, 5).unwrap();
+        let frames: Vec<(usize, usize)> = table.rows.iter().map(|r| (r.frame, r.rank)).collect();
+        assert_eq!(frames, [(0, 0), (0, 1), (2, 0), (4, 0)]);
+        assert_eq!(table.rows[3].state[4], 4.0);
+    }
+
     #[test]
     fn board_work_sums_the_tracked_frames_only() {
         let summary = StreamSummary {
@@ -478,6 +579,7 @@ mod tests {
             out: PathBuf::from("states.csv"),
             link: LinkReport::default(),
             board_clock_hz: 25_000_000,
+            hypotheses_out: None,
         };
         let work = summary.board_work().unwrap();
         assert_eq!((work.frames, work.ticks, work.iterations), (2, 150_000, 12));
@@ -506,6 +608,7 @@ mod tests {
             out: PathBuf::from("states.csv"),
             link: LinkReport::default(),
             board_clock_hz: 1,
+            hypotheses_out: None,
         };
         let e = summary.ensure_some_tracked().unwrap_err().to_string();
         assert!(e.contains("tracked none of the 2 frame(s)"), "{e}");
@@ -528,6 +631,7 @@ mod tests {
             out: PathBuf::from("states.csv"),
             link: LinkReport::default(),
             board_clock_hz: 1,
+            hypotheses_out: None,
         };
         assert_eq!(summary.statuses(), [2, 1, 1]);
         let text = summary.to_string();

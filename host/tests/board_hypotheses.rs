@@ -4,7 +4,8 @@
 //! one and counts them; a count out of 1..=8, or with one board per camera, is refused clearly;
 //! `--score-every S` (protocol version 9) and the caps on the hypotheses' iterations
 //! (`--sample-iterations`, `--other-iterations`, protocol version 10) reach the board, and are
-//! refused where they mean nothing.
+//! refused where they mean nothing; `--hypotheses-out` writes what the board carried, the same
+//! file as `track`'s.
 
 mod common;
 
@@ -121,6 +122,77 @@ fn stream_with_hypotheses_counts_what_the_board_carried() {
     );
 }
 
+/// `stream --hypotheses-out` writes the hypotheses the board sent, and since the board's
+/// tracker is the host's, the file is byte for byte the one `track --hypotheses-out` writes
+/// on the same sequence.
+#[test]
+fn stream_writes_the_boards_hypotheses_as_track_writes_its_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = 8;
+    common::small_sequence(dir.path(), "fullhand-mono", frames);
+    let digiteyes = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_digiteyes"))
+            .args(args)
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            out.status.success(),
+            "{args:?}: {stdout}\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        stdout
+    };
+    let board = sim::start(SimOptions::default()).unwrap();
+    let port = board.path().display().to_string();
+    let streamed = digiteyes(&[
+        "stream",
+        "--port",
+        &port,
+        "--seq",
+        "fullhand-mono",
+        "--hypotheses",
+        "3",
+        "--hypotheses-out",
+        "board-hyp.csv",
+        "--out",
+        "board.csv",
+        "--quiet",
+    ]);
+    board.stop().unwrap();
+    digiteyes(&[
+        "track",
+        "fullhand-mono",
+        "--hypotheses",
+        "3",
+        "--hypotheses-out",
+        "host-hyp.csv",
+        "--out",
+        "host.csv",
+        "--quiet",
+    ]);
+    let read = |name: &str| std::fs::read_to_string(dir.path().join(name)).unwrap();
+    let (on_board, on_host) = (read("board-hyp.csv"), read("host-hyp.csv"));
+    let rows = on_board.lines().count() - 1;
+    assert!(
+        rows > frames,
+        "more than one hypothesis on some frame: {rows} rows"
+    );
+    assert!(
+        streamed.contains(&format!(
+            "hypotheses: {rows} row(s) written to board-hyp.csv"
+        )),
+        "{streamed}"
+    );
+    assert_eq!(on_board, on_host, "the board's hypotheses are the host's");
+    let last = on_board.lines().last().unwrap();
+    assert!(
+        last.starts_with(&format!("{},", frames - 1)),
+        "the last frame's hypotheses (they follow its state) are written: {last}"
+    );
+}
+
 fn state(frame: u32) -> BoardMessage {
     BoardMessage::State(State {
         frame,
@@ -189,7 +261,7 @@ fn a_hypothesis_count_out_of_range_or_with_a_board_per_camera_is_refused_clearly
     let one_board = ["--port", "/nonexistent/a", "--seq", "mono"];
     let two_boards = [&common::TWO_ABSENT_BOARDS[..], &["--seq", "stereo"]].concat();
     // (the boards, the options, what the error must name)
-    let cases: [(&[&str], &[&str], [&str; 2]); 8] = [
+    let cases: [(&[&str], &[&str], [&str; 2]); 10] = [
         (
             &one_board,
             &["--hypotheses", "0"],
@@ -230,6 +302,16 @@ fn a_hypothesis_count_out_of_range_or_with_a_board_per_camera_is_refused_clearly
             &["--no-keep-fingers"],
             ["--no-keep-fingers", "only several hypotheses"],
         ),
+        (
+            &one_board,
+            &["--hypotheses-out", "one.csv"],
+            ["--hypotheses-out one.csv", "only when it carries several"],
+        ),
+        (
+            &two_boards,
+            &["--hypotheses", "2", "--hypotheses-out", "two.csv"],
+            ["--hypotheses-out", "one board per camera"],
+        ),
     ];
     for (boards, options, named) in cases {
         let mut args = vec!["stream"];
@@ -241,4 +323,5 @@ fn a_hypothesis_count_out_of_range_or_with_a_board_per_camera_is_refused_clearly
             "{options:?}: {stderr}"
         );
     }
+    assert!(!dir.path().join("one.csv").exists() && !dir.path().join("two.csv").exists());
 }

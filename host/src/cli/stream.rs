@@ -97,6 +97,11 @@ pub struct StreamArgs {
     /// What the board's hypotheses other than the best may cost (protocol version 10).
     #[command(flatten)]
     pub hypothesis_budget: HypothesisBudgetArgs,
+    /// With --hypotheses K > 1: also write every hypothesis the board sends, one row per
+    /// hypothesis per frame, best first, to FILE: the file `track --hypotheses-out` writes
+    /// (`digiteyes report` and `ui` read it).
+    #[arg(long, value_name = "FILE")]
+    pub hypotheses_out: Option<PathBuf>,
     /// Output CSV path (default: states.csv in the current folder).
     #[arg(long, short, default_value = "states.csv", hide_default_value = true)]
     pub out: PathBuf,
@@ -164,6 +169,17 @@ fn single_board_options(
     }
     options.hypotheses =
         hypotheses::asked(args.hypotheses, args.score_every, &args.hypothesis_budget)?;
+    if let Some(path) = &args.hypotheses_out {
+        if options.hypotheses.count <= 1 {
+            bail!(
+                "--hypotheses-out {}: a board sends its hypotheses only when it carries \
+                 several; give --hypotheses K with K > 1 (with one, the states file is all \
+                 there is)",
+                path.display()
+            );
+        }
+        options.hypotheses_out = Some(path.clone());
+    }
     Ok(options)
 }
 
@@ -186,10 +202,14 @@ pub fn run(args: StreamArgs, progress: bool) -> Result<()> {
                  initial_state only (accepted: --init given); a single board searches itself"
             );
         }
-        if args.hypotheses.is_some() || args.score_every.is_some() || args.hypothesis_budget.any() {
+        if args.hypotheses.is_some()
+            || args.score_every.is_some()
+            || args.hypothesis_budget.any()
+            || args.hypotheses_out.is_some()
+        {
             bail!(
                 "--hypotheses, --score-every, --sample-iterations, --other-iterations, \
-                 --no-keep-fingers: with one board per camera the host tracks, and its stereo \
+                 --no-keep-fingers, --hypotheses-out: with one board per camera the host tracks, and its stereo \
                  tracker carries one hypothesis; leave them out, or stream one camera to one \
                  board (--camera-index)"
             );
@@ -282,5 +302,12 @@ mod tests {
         assert_eq!(asked.search_evaluations_per_frame, 7);
         let err = options(&["--no-keep-fingers"]).unwrap_err().to_string();
         assert!(err.contains("--no-keep-fingers"), "{err}");
+        let written = options(&["--hypotheses", "2", "--hypotheses-out", "h.csv"]).unwrap();
+        assert_eq!(written.hypotheses_out, Some(PathBuf::from("h.csv")));
+        assert_eq!(options(&[]).unwrap().hypotheses_out, None);
+        let err = options(&["--hypotheses-out", "h.csv"])
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("--hypotheses-out h.csv:"), "{err}");
     }
 }

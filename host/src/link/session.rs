@@ -19,8 +19,8 @@ use std::time::Instant;
 use anyhow::{bail, Result};
 use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::protocol::{
-    BoardMessage, Command, Configure, FrameChunk, Hello, HostMessage, Refusal, Reset, Start,
-    WireStatus, MAX_CHUNK, PROTOCOL_VERSION,
+    BoardMessage, Command, Configure, FrameChunk, Hello, HostMessage, Hypotheses, Refusal, Reset,
+    Start, WireStatus, MAX_CHUNK, PROTOCOL_VERSION,
 };
 use heapless::Vec as HVec;
 
@@ -56,6 +56,9 @@ pub struct Session {
     probes: u32,
     /// Frames in a row with no byte at all from the board.
     silent: u32,
+    /// The `Hypotheses` messages received and not yet taken, when kept
+    /// ([`Session::keep_hypotheses`]); `None`: only counted.
+    hypotheses: Option<Vec<Hypotheses>>,
 }
 
 impl Session {
@@ -72,11 +75,29 @@ impl Session {
             report: LinkReport::default(),
             probes: 0,
             silent: 0,
+            hypotheses: None,
         };
         let q = session.last_state.clone();
         session.hello = session.handshake(&q, session.last_start, None)?;
         session.started = Instant::now();
         Ok(session)
+    }
+
+    /// From now on, keeps every `Hypotheses` message the board sends until
+    /// [`take_hypotheses`](Self::take_hypotheses) (they are always counted in the report).
+    pub fn keep_hypotheses(&mut self) {
+        self.hypotheses.get_or_insert_with(Vec::new);
+    }
+
+    /// The `Hypotheses` messages kept since the last call, in the order received (none unless
+    /// [`keep_hypotheses`](Self::keep_hypotheses) was called). A frame's message follows its
+    /// `State`, so it arrives while the next frame's answer, or [`finish`](Self::finish)'s, is
+    /// awaited.
+    pub fn take_hypotheses(&mut self) -> Vec<Hypotheses> {
+        self.hypotheses
+            .as_mut()
+            .map(std::mem::take)
+            .unwrap_or_default()
     }
 
     /// The board's `Hello` (the latest).
@@ -279,7 +300,12 @@ impl Session {
             BoardMessage::Features(_) => self.report.features += 1,
             // They follow their frame's State, so they arrive while the next frame (or the
             // final ping) is awaited.
-            BoardMessage::Hypotheses(h) => self.report.count_hypotheses(&h),
+            BoardMessage::Hypotheses(h) => {
+                self.report.count_hypotheses(&h);
+                if let Some(kept) = self.hypotheses.as_mut() {
+                    kept.push(h);
+                }
+            }
             BoardMessage::LinkEdges(_) | BoardMessage::PalmEdges(_) | BoardMessage::Measured(_) => {
                 self.report.late_answers += 1
             }

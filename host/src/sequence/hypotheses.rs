@@ -1,5 +1,5 @@
-//! The hypotheses CSV (`track --hypotheses-out`): every hypothesis the tracker carries, frame
-//! by frame (`docs/hypotheses.md`).
+//! The hypotheses CSV (`track --hypotheses-out`, `stream --hypotheses-out`): every hypothesis
+//! the tracker carries, frame by frame (`docs/hypotheses.md`).
 //!
 //! Header `frame,rank,score,age,q0,...,q{n-1}`; one row per hypothesis carried after a frame,
 //! best first (`rank` 0 is the best: the state `track` outputs for that frame, written as in
@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use digiteyes_core::config::MAX_HYPOTHESES;
 use digiteyes_core::hypotheses::Hypothesis;
+use digiteyes_core::protocol::Hypotheses;
 
 use super::states::{push_states, state_header};
 use crate::text::quote_value;
@@ -183,20 +184,41 @@ impl HypothesesWriter {
     /// Appends frame `frame`'s hypotheses, best first (none: no row).
     pub fn write_frame(&mut self, frame: usize, hypotheses: &[Hypothesis]) -> Result<()> {
         for (rank, h) in hypotheses.iter().enumerate() {
-            let state = &h.memory.state;
-            if state.len() != self.n_states {
-                bail!(
-                    "{}: frame {frame}: a hypothesis has {} states, the header {}",
-                    self.path.display(),
-                    state.len(),
-                    self.n_states
-                );
-            }
-            let mut line = format!("{frame},{rank},{},{}", h.score, h.age);
-            push_states(&mut line, state);
-            self.line(&line)?;
-            self.rows += 1;
+            self.write_row(frame, rank, h.score, h.age, &h.memory.state)?;
         }
+        Ok(())
+    }
+
+    /// Appends the hypotheses a board sent after one frame (`BoardMessage::Hypotheses`), best
+    /// first, as [`write_frame`](Self::write_frame) writes the tracker's own (none: no row).
+    pub fn write_message(&mut self, message: &Hypotheses) -> Result<()> {
+        let frame = message.frame as usize;
+        for (rank, h) in message.hypotheses.iter().enumerate() {
+            self.write_row(frame, rank, h.score, h.age, &h.q)?;
+        }
+        Ok(())
+    }
+
+    fn write_row(
+        &mut self,
+        frame: usize,
+        rank: usize,
+        score: f32,
+        age: u32,
+        state: &[f32],
+    ) -> Result<()> {
+        if state.len() != self.n_states {
+            bail!(
+                "{}: frame {frame}: a hypothesis has {} states, the header {}",
+                self.path.display(),
+                state.len(),
+                self.n_states
+            );
+        }
+        let mut line = format!("{frame},{rank},{score},{age}");
+        push_states(&mut line, state);
+        self.line(&line)?;
+        self.rows += 1;
         Ok(())
     }
 
