@@ -114,7 +114,12 @@ impl StatesWithGaps {
 pub fn read_states_with_gaps(path: &Path, n_states: usize) -> Result<StatesWithGaps> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    parse_table(&text, n_states, true).with_context(|| format!("{}", path.display()))
+    parse_states_with_gaps(&text, n_states).with_context(|| format!("{}", path.display()))
+}
+
+/// Parses the text of a state CSV as [`read_states_with_gaps`] reads it.
+pub fn parse_states_with_gaps(text: &str, n_states: usize) -> Result<StatesWithGaps> {
+    parse_table(text, n_states, true)
 }
 
 /// Parses a state CSV; with `gaps`, states that are not finite numbers become NaN.
