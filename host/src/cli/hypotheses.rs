@@ -10,6 +10,16 @@ use clap::Args;
 
 use digiteyes_core::protocol::HypothesesParams;
 
+/// `--hypotheses`' values: a whole number 1..=MAX_HYPOTHESES.
+pub fn count(text: &str) -> Result<u8, String> {
+    let max = digiteyes_core::config::MAX_HYPOTHESES;
+    let range = format!("a whole number from 1 to {max} (1: the single tracker)");
+    match text.trim().parse::<usize>() {
+        Ok(k) if (1..=max).contains(&k) => u8::try_from(k).map_err(|_| range),
+        _ => Err(format!("{} is not {range}", crate::text::quote_value(text))),
+    }
+}
+
 /// The hypotheses asked for: `count` (left out: the default), scored one frame in
 /// `score_every` (left out: the default), under `budget`. Refuses a scoring period or a budget
 /// for a single hypothesis, where either would change nothing.

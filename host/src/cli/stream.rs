@@ -4,7 +4,6 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
-use digiteyes_core::config::MAX_HYPOTHESES;
 use digiteyes_core::protocol::{Start, TrackerParams};
 
 use super::hypotheses::{self, HypothesisBudgetArgs};
@@ -86,7 +85,7 @@ pub struct StreamArgs {
     /// single tracker; with more the board sends them after every state (protocol version
     /// 5) and the summary counts them (carried on average, the best's mean score). A single
     /// board only: with one board per camera the host tracks.
-    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u8).range(1..=MAX_HYPOTHESES as i64))]
+    #[arg(long, value_name = "K", value_parser = hypotheses::count)]
     pub hypotheses: Option<u8>,
     /// With --hypotheses K > 1: the board scores its hypotheses on one frame in S, 1 to 255
     /// (default 1: every frame; protocol version 9): K = 2 at S = 4 fits 30 frames/s on a

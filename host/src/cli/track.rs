@@ -80,7 +80,7 @@ pub struct TrackArgs {
     /// board's budget). On the randomised sweep 4 kept the hand longer than 1 (+3.7 points of
     /// track life over 360 seeds, though 24 seeds did worse) at about 7 times the cost per
     /// frame; docs/hypotheses.md.
-    #[arg(long, value_name = "K", default_value_t = 1, value_parser = hypotheses_count)]
+    #[arg(long, value_name = "K", default_value_t = 1, value_parser = hypotheses::count)]
     pub hypotheses: u8,
     /// Also write every hypothesis carried, one row per hypothesis per frame, to FILE.
     #[arg(long, value_name = "FILE")]
@@ -92,16 +92,6 @@ pub struct TrackArgs {
     /// What the hypotheses other than the best may cost.
     #[command(flatten)]
     pub hypothesis_budget: HypothesisBudgetArgs,
-}
-
-/// `--hypotheses`' values: a whole number 1..=MAX_HYPOTHESES.
-fn hypotheses_count(text: &str) -> Result<u8, String> {
-    let max = digiteyes_core::config::MAX_HYPOTHESES;
-    let range = format!("a whole number from 1 to {max} (1: the single tracker)");
-    match text.trim().parse::<usize>() {
-        Ok(k) if (1..=max).contains(&k) => u8::try_from(k).map_err(|_| range),
-        _ => Err(format!("{} is not {range}", crate::text::quote_value(text))),
-    }
 }
 
 /// `--init`'s values.
