@@ -139,7 +139,8 @@ pub struct StreamSummary {
     /// Ticks per second of the board's clock (`Hello::clock_hz`), the unit of `track_ticks`.
     pub board_clock_hz: u32,
     /// Where the board's hypotheses were written, the rows written, and the messages left out
-    /// because their frame did not follow the last one written (none from a working board).
+    /// because their frame did not follow the last one written or a hypothesis had another
+    /// number of states than the model (none from a working board).
     pub hypotheses_out: Option<(PathBuf, usize, usize)>,
 }
 
@@ -289,7 +290,10 @@ impl fmt::Display for StreamSummary {
         if let Some((path, rows, skipped)) = &self.hypotheses_out {
             write!(f, "hypotheses: {rows} row(s) written to {}", path.display())?;
             if *skipped > 0 {
-                write!(f, " ({skipped} message(s) out of frame order left out)")?;
+                write!(
+                    f,
+                    " ({skipped} message(s) out of frame order or of the wrong size left out)"
+                )?;
             }
             writeln!(f)?;
         }
@@ -398,6 +402,7 @@ fn run(
             session.keep_hypotheses();
             Some(BoardHypotheses {
                 writer: HypothesesWriter::create(path, sequence.n_states())?,
+                n_states: sequence.n_states(),
                 next_frame: 0,
                 skipped: 0,
             })
@@ -468,11 +473,16 @@ fn run(
 }
 
 /// The board's hypotheses on their way to the file: each message's rows, frames ascending.
+/// A message the file cannot hold is left out and counted, so the stream (and its states
+/// file) goes on.
 struct BoardHypotheses {
     writer: HypothesesWriter,
+    /// The model's states: every hypothesis of a message written must have as many.
+    n_states: usize,
     /// The first frame a message may be written for (frames ascend in the file).
     next_frame: u64,
-    /// Messages left out because their frame did not follow the last one written.
+    /// Messages left out: their frame did not follow the last one written, or a hypothesis
+    /// had another number of states than the model.
     skipped: usize,
 }
 
@@ -480,7 +490,11 @@ impl BoardHypotheses {
     fn write(&mut self, messages: Vec<Hypotheses>) -> Result<()> {
         for message in messages {
             let frame = u64::from(message.frame);
-            if frame < self.next_frame {
+            let whole = message
+                .hypotheses
+                .iter()
+                .all(|h| h.q.len() == self.n_states);
+            if frame < self.next_frame || !whole {
                 self.skipped += 1;
                 continue;
             }
@@ -529,7 +543,8 @@ mod tests {
     }
 
     /// Messages are written as they come while their frames ascend; one whose frame does not
-    /// follow the last written is left out and counted, not written out of order.
+    /// follow the last written, or with a hypothesis of another size than the model's, is left
+    /// out and counted (not written, and not an error that would end the stream).
     #[test]
     fn the_boards_hypotheses_are_written_in_frame_order_only() {
         use digiteyes_core::protocol::WireHypothesis;
@@ -547,18 +562,22 @@ mod tests {
         };
         let mut out = BoardHypotheses {
             writer: HypothesesWriter::create(&path, 5).unwrap(),
+            n_states: 5,
             next_frame: 0,
             skipped: 0,
         };
         out.write(vec![message(0, 2), message(2, 1)]).unwrap();
+        let mut short = message(3, 2);
+        short.hypotheses[1].q.pop();
         out.write(vec![
             message(2, 3),
             message(1, 1),
+            short,
             message(3, 0),
             message(4, 1),
         ])
         .unwrap();
-        assert_eq!(out.skipped, 2);
+        assert_eq!(out.skipped, 3);
         assert_eq!(out.writer.finish().unwrap(), 4);
         let table = crate::sequence::hypotheses::read_hypotheses(&path, 5).unwrap();
         let frames: Vec<(usize, usize)> = table.rows.iter().map(|r| (r.frame, r.rank)).collect();
