@@ -269,18 +269,31 @@ fn palm_depth_mm(cameras: &[Camera], state: &[f32]) -> Option<f32> {
     Some((Vector3::new(p[0], p[1], p[2]) - camera.centre()).norm())
 }
 
-/// One edge map per camera: `frames[i]`'s, built into `edge_buffers[i]`.
+/// One edge map per camera, with its bright region, for the search: `frames[i]`'s, built
+/// into `edge_buffers[i]`.
 fn edge_maps<'b>(
     edge_buffers: &'b mut [&mut [u8]],
     frames: &[FrameView<'_>],
     likelihood: &LikelihoodConfig,
 ) -> Result<Vec<EdgeMap<'b>, MAX_CAMERAS>, AutoError> {
-    reopened_edge_maps(edge_buffers, frames, likelihood, &[])
+    if edge_buffers.len() < frames.len() {
+        return Err(AutoError::BufferCount);
+    }
+    let mut maps = Vec::new();
+    for (buffer, frame) in edge_buffers.iter_mut().zip(frames) {
+        let map = EdgeMap::build(buffer, frame, likelihood).map_err(AutoError::EdgeMap)?;
+        if maps.push(map).is_err() {
+            return Err(AutoError::Tracker(TrackerError::CameraCount));
+        }
+    }
+    Ok(maps)
 }
 
-/// The same, opening again the maps `built` on this frame already ([`MultiTracker::take_built_edges`]:
-/// `edge_buffers` untouched since) instead of building them a second time, when they are
-/// one per camera and of these frames' sizes under `likelihood`.
+/// One edge map per camera for a score, without the bright region a score never reads
+/// ([`EdgeMap::build_edges`]): the maps `built` on this frame already
+/// ([`MultiTracker::take_built_edges`]: `edge_buffers` untouched since) opened again instead
+/// of built a second time, when they are one per camera and of these frames' sizes under
+/// `likelihood`.
 fn reopened_edge_maps<'b>(
     edge_buffers: &'b mut [&mut [u8]],
     frames: &[FrameView<'_>],
@@ -299,7 +312,7 @@ fn reopened_edge_maps<'b>(
     for (k, (buffer, frame)) in edge_buffers.iter_mut().zip(frames).enumerate() {
         let map = match built.get(k) {
             Some(b) if reuse => EdgeMap::reopen(buffer, *b),
-            _ => EdgeMap::build(buffer, frame, likelihood),
+            _ => EdgeMap::build_edges(buffer, frame, likelihood),
         }
         .map_err(AutoError::EdgeMap)?;
         if maps.push(map).is_err() {

@@ -243,7 +243,8 @@ impl MultiTracker {
         let likelihood = self.config.likelihood;
         let mut maps: Vec<EdgeMap<'_>, MAX_CAMERAS> = Vec::new();
         for (buffer, frame) in edge_buffers.iter_mut().zip(frames) {
-            let map = EdgeMap::build(buffer, frame, &likelihood).map_err(AutoError::EdgeMap)?;
+            let map =
+                EdgeMap::build_edges(buffer, frame, &likelihood).map_err(AutoError::EdgeMap)?;
             let built = map.built(frame, &likelihood);
             if maps.push(map).is_err() {
                 return Err(AutoError::Tracker(TrackerError::CameraCount));
