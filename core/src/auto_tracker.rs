@@ -56,7 +56,7 @@ use crate::config::{MAX_CAMERAS, MAX_HYPOTHESES, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
 use crate::hypotheses::{HypothesesConfig, Hypothesis, MultiReport, MultiTracker};
-use crate::likelihood::{BuiltEdges, EdgeMap, LikelihoodConfig, LikelihoodError, Scene};
+use crate::likelihood::{BuiltEdges, EdgeMap, LikelihoodConfig, LikelihoodError, Reads, Scene};
 use crate::model::Model;
 use crate::motion::PriorWeights;
 use crate::nalgebra::Vector3;
@@ -289,16 +289,17 @@ fn edge_maps<'b>(
     Ok(maps)
 }
 
-/// One edge map per camera for a score, without the bright region a score never reads
-/// ([`EdgeMap::build_edges`]): the maps `built` on this frame already
-/// ([`MultiTracker::take_built_edges`]: `edge_buffers` untouched since) opened again instead
-/// of built a second time, when they are one per camera and of these frames' sizes under
-/// `likelihood`.
+/// One edge map per camera for a score that reads camera `i`'s as `reads[i]` says, without
+/// the bright region a score never reads ([`EdgeMap::build_edges_for`]): the maps `built` on
+/// this frame already ([`MultiTracker::take_built_edges`]: `edge_buffers` untouched since)
+/// opened again instead of built a second time, when they are one per camera, of these
+/// frames' sizes under `likelihood`, and cover those reads.
 fn reopened_edge_maps<'b>(
     edge_buffers: &'b mut [&mut [u8]],
     frames: &[FrameView<'_>],
     likelihood: &LikelihoodConfig,
     built: &[BuiltEdges],
+    reads: &[Reads; MAX_CAMERAS],
 ) -> Result<Vec<EdgeMap<'b>, MAX_CAMERAS>, AutoError> {
     if edge_buffers.len() < frames.len() {
         return Err(AutoError::BufferCount);
@@ -307,12 +308,13 @@ fn reopened_edge_maps<'b>(
         && built
             .iter()
             .zip(frames)
-            .all(|(b, frame)| b.fits(frame, likelihood));
+            .zip(reads)
+            .all(|((b, frame), r)| b.fits(frame, likelihood) && b.covers(r, likelihood));
     let mut maps = Vec::new();
-    for (k, (buffer, frame)) in edge_buffers.iter_mut().zip(frames).enumerate() {
+    for (k, ((buffer, frame), r)) in edge_buffers.iter_mut().zip(frames).zip(reads).enumerate() {
         let map = match built.get(k) {
             Some(b) if reuse => EdgeMap::reopen(buffer, *b),
-            _ => EdgeMap::build_edges(buffer, frame, likelihood),
+            _ => EdgeMap::build_edges_for(buffer, frame, likelihood, *r),
         }
         .map_err(AutoError::EdgeMap)?;
         if maps.push(map).is_err() {
@@ -713,9 +715,13 @@ impl AutoTracker {
         likelihood: &LikelihoodConfig,
         reverse: bool,
     ) -> Result<(f32, Option<f32>), AutoError> {
-        let maps = reopened_edge_maps(edge_buffers, frames, likelihood, built)?;
         let tracker = self.multi.tracker();
         let q = padded(tracker.state());
+        let mut reads = [Reads::Nowhere; MAX_CAMERAS];
+        self.finder
+            .acquirer_mut()
+            .add_reads(tracker.model(), tracker.cameras(), &q, &mut reads);
+        let maps = reopened_edge_maps(edge_buffers, frames, likelihood, built, &reads)?;
         let scene = Scene::new(tracker.model(), tracker.cameras(), frames, &maps);
         let acquirer = self.finder.acquirer_mut();
         let (_, worst) = acquirer.score_cameras_under(&scene, &q, likelihood);
@@ -854,7 +860,9 @@ impl AutoTracker {
             return Ok(());
         };
         let likelihood = self.finder.acquirer().config().likelihood;
-        let maps = reopened_edge_maps(edge_buffers, frames, &likelihood, built)?;
+        // The fingers' library poses may reach anywhere: the whole frame's maps.
+        let reads = [Reads::Everywhere; MAX_CAMERAS];
+        let maps = reopened_edge_maps(edge_buffers, frames, &likelihood, built, &reads)?;
         let tracker = self.multi.tracker();
         let q = padded(tracker.state());
         let scene = Scene::new(tracker.model(), tracker.cameras(), frames, &maps);

@@ -27,7 +27,7 @@ use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::likelihood::{
-    BoundedScore, EdgeMap, Likelihood, LikelihoodConfig, Region, Samples, Scene,
+    BoundedScore, EdgeMap, Likelihood, LikelihoodConfig, Reads, Region, Samples, Scene,
 };
 use crate::model::Model;
 use crate::nalgebra::{Vector2, Vector3};
@@ -570,6 +570,19 @@ impl Acquirer {
         let config = self.config.likelihood;
         self.scratch
             .worst_reverse_px(scene, &q[..self.n_states], &config)
+    }
+
+    /// Adds where scoring `q` reads each camera's edge map to `reads`
+    /// ([`crate::likelihood::StateScorer::add_reads`]).
+    pub fn add_reads(
+        &mut self,
+        model: &Model,
+        cameras: &[Camera],
+        q: &[f32; MAX_STATES],
+        reads: &mut [Reads],
+    ) {
+        self.scratch
+            .add_reads(model, cameras, &q[..self.n_states], reads);
     }
 
     /// [`Self::score_cameras`] under another likelihood `config` (whose edge maps `scene`

@@ -35,7 +35,7 @@ use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_CANDIDATES, MAX_HYPOTHESES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
-use crate::likelihood::{BuiltEdges, EdgeMap, Scene};
+use crate::likelihood::{BuiltEdges, EdgeMap, Reads, Scene};
 use crate::state::{clamp_to_limit, renormalise_quaternion};
 use crate::tracker::{FrameReport, TrackMemory, Tracker, TrackerError};
 use score::StateScorer;
@@ -241,16 +241,10 @@ impl MultiTracker {
             return self.carry(frames);
         }
         let likelihood = self.config.likelihood;
-        let mut maps: Vec<EdgeMap<'_>, MAX_CAMERAS> = Vec::new();
-        for (buffer, frame) in edge_buffers.iter_mut().zip(frames) {
-            let map =
-                EdgeMap::build_edges(buffer, frame, &likelihood).map_err(AutoError::EdgeMap)?;
-            let built = map.built(frame, &likelihood);
-            if maps.push(map).is_err() {
-                return Err(AutoError::Tracker(TrackerError::CameraCount));
-            }
-            // As many as `maps` holds, so never full here.
-            let _ = self.built.push(built);
+        // The maps are built once the candidates are known (step 3); a buffer that could not
+        // hold one fails the frame before any hypothesis moves.
+        for (buffer, frame) in edge_buffers.iter().zip(frames) {
+            EdgeMap::check_buffer(buffer.len(), frame, &likelihood).map_err(AutoError::EdgeMap)?;
         }
         let mut candidates: Vec<Hypothesis, MAX_CANDIDATES> = Vec::new();
         // `parents[c]`: the carried hypothesis candidate `c` descends from.
@@ -378,7 +372,27 @@ impl MultiTracker {
             });
             let _ = parents.push(0);
         }
-        // 3. Scores.
+        // 3. Scores, on maps of the cells the candidates' scores read.
+        let mut reads = [Reads::Nowhere; MAX_CAMERAS];
+        for c in &candidates {
+            self.scorer.add_reads(
+                self.tracker.model(),
+                self.tracker.cameras(),
+                &c.memory.state,
+                &mut reads,
+            );
+        }
+        let mut maps: Vec<EdgeMap<'_>, MAX_CAMERAS> = Vec::new();
+        for ((buffer, frame), reads) in edge_buffers.iter_mut().zip(frames).zip(reads) {
+            let map = EdgeMap::build_edges_for(buffer, frame, &likelihood, reads)
+                .map_err(AutoError::EdgeMap)?;
+            let built = map.built(frame, &likelihood);
+            if maps.push(map).is_err() {
+                return Err(AutoError::Tracker(TrackerError::CameraCount));
+            }
+            // As many as `maps` holds, so never full here.
+            let _ = self.built.push(built);
+        }
         let free = self.tracker.free();
         for (c, &parent) in candidates.iter_mut().zip(&parents) {
             let scene = Scene::new(self.tracker.model(), self.tracker.cameras(), frames, &maps);

@@ -15,6 +15,7 @@ use core::f32::consts::PI;
 use crate::frame::FrameView;
 use crate::nalgebra::Vector2;
 
+use super::reads::{CellRect, Reads};
 use super::region::{Region, RegionBuilder};
 use super::{LikelihoodConfig, LikelihoodError};
 
@@ -64,6 +65,7 @@ pub struct BuiltEdges {
     stride_px: usize,
     edge_cells: u32,
     region: Option<Region>,
+    within: CellRect,
 }
 
 impl BuiltEdges {
@@ -74,6 +76,13 @@ impl BuiltEdges {
             && self.height == frame.height()
             && self.stride_px == usize::from(config.stride_px)
             && self.min_gradient.to_bits() == config.min_gradient.to_bits()
+    }
+
+    /// Whether the map reads as one built over the whole frame wherever `reads` reads it
+    /// under `config` (a map built for other reads may have left those cells out).
+    pub fn covers(&self, reads: &Reads, config: &LikelihoodConfig) -> bool {
+        let needed = reads.cells(self.cols, self.rows, self.stride_px, config);
+        self.within.contains(&needed)
     }
 }
 
@@ -89,6 +98,9 @@ pub struct EdgeMap<'b> {
     /// The frame's bright region (the hand is brighter than the background), when the frame
     /// has one.
     pub region: Option<Region>,
+    /// The cells whose marks and distances were found; every other cell reads as far from
+    /// any edge.
+    within: CellRect,
 }
 
 impl<'b> EdgeMap<'b> {
@@ -96,6 +108,26 @@ impl<'b> EdgeMap<'b> {
     pub fn bytes_needed(width: usize, height: usize, stride_px: u8) -> usize {
         let s = usize::from(stride_px.max(1));
         width.div_ceil(s) * height.div_ceil(s) * EDGE_BINS
+    }
+
+    /// The bytes a build of `frame`'s map under `config` uses, or why a buffer of
+    /// `buffer_len` bytes cannot hold it: what every build checks first, for a caller that
+    /// must know before it starts work it could not finish.
+    pub fn check_buffer(
+        buffer_len: usize,
+        frame: &FrameView<'_>,
+        config: &LikelihoodConfig,
+    ) -> Result<usize, LikelihoodError> {
+        if config.stride_px == 0 {
+            return Err(LikelihoodError::ZeroStride);
+        }
+        let needed = Self::bytes_needed(frame.width(), frame.height(), config.stride_px);
+        if buffer_len < needed {
+            return Err(LikelihoodError::BufferTooSmall {
+                needed: u32::try_from(needed).unwrap_or(u32::MAX),
+            });
+        }
+        Ok(needed)
     }
 
     /// Finds `frame`'s edges, their distance maps and its bright region into `buffer`: the
@@ -108,7 +140,7 @@ impl<'b> EdgeMap<'b> {
     ) -> Result<Self, LikelihoodError> {
         let (w, h) = (frame.width(), frame.height());
         let mut region = RegionBuilder::new(w, h);
-        let mut map = Self::build_marking(buffer, frame, config, &mut region)?;
+        let mut map = Self::build_marking(buffer, frame, config, Reads::Everywhere, &mut region)?;
         map.region = region.finish(frame);
         Ok(map)
     }
@@ -123,21 +155,33 @@ impl<'b> EdgeMap<'b> {
         frame: &FrameView<'_>,
         config: &LikelihoodConfig,
     ) -> Result<Self, LikelihoodError> {
-        Self::build_marking(buffer, frame, config, &mut NoGreyLevels)
+        Self::build_marking(buffer, frame, config, Reads::Everywhere, &mut NoGreyLevels)
     }
 
-    /// The distance maps, the sampled grey levels given to `grey`.
+    /// [`EdgeMap::build_edges`] for a score that reads the map only as `reads` says, under
+    /// `config`: only the cells such reads depend on are found ([`Reads::cells`]), and those
+    /// reads return what they would on the whole frame's map, bit for bit. A hand a third of
+    /// a 640×480 frame wide needs about a fifth of its cells.
+    #[inline(never)] // a stage of the loop: kept whole so profiles can attribute its cost
+    pub fn build_edges_for(
+        buffer: &'b mut [u8],
+        frame: &FrameView<'_>,
+        config: &LikelihoodConfig,
+        reads: Reads,
+    ) -> Result<Self, LikelihoodError> {
+        Self::build_marking(buffer, frame, config, reads, &mut NoGreyLevels)
+    }
+
+    /// The distance maps of the cells `reads` needs, the sampled grey levels given to `grey`.
     fn build_marking(
         buffer: &'b mut [u8],
         frame: &FrameView<'_>,
         config: &LikelihoodConfig,
+        reads: Reads,
         grey: &mut impl GreyLevels,
     ) -> Result<Self, LikelihoodError> {
-        if config.stride_px == 0 {
-            return Err(LikelihoodError::ZeroStride);
-        }
+        let needed = Self::check_buffer(buffer.len(), frame, config)?;
         let (w, h) = (frame.width(), frame.height());
-        let needed = Self::bytes_needed(w, h, config.stride_px);
         let Some(dist) = buffer.get_mut(..needed) else {
             return Err(LikelihoodError::BufferTooSmall {
                 needed: u32::try_from(needed).unwrap_or(u32::MAX),
@@ -153,6 +197,7 @@ impl<'b> EdgeMap<'b> {
             stride_px: s,
             edge_cells: 0,
             region: None,
+            within: reads.cells(cols, rows, s, config),
         };
         map.mark_edges(frame, config.min_gradient, grey);
         for bin in 0..EDGE_BINS {
@@ -173,6 +218,7 @@ impl<'b> EdgeMap<'b> {
             stride_px: self.stride_px,
             edge_cells: self.edge_cells,
             region: self.region,
+            within: self.within,
         }
     }
 
@@ -194,6 +240,7 @@ impl<'b> EdgeMap<'b> {
             stride_px: built.stride_px,
             edge_cells: built.edge_cells,
             region: built.region,
+            within: built.within,
         })
     }
 
@@ -225,13 +272,15 @@ impl<'b> EdgeMap<'b> {
         let px = |row: &[u8], x: usize| i32::from(row.get(x).copied().unwrap_or(0));
         // Odd rows and columns (every one when the step is 1).
         let odd = |v: usize| if step > 1 { v | 1 } else { v };
-        for cy in 0..self.rows {
+        let within = self.within;
+        for cy in within.y0..within.y1.min(self.rows) {
             let (y0, y1) = ((cy * s).max(1), ((cy + 1) * s).min(h.saturating_sub(1)));
             // Up to CELL_CHUNK cells of the row at once, so each pixel row is looked up once
             // per chunk; each cell still visits its pixels row by row, left to right.
-            let mut c0 = 0;
-            while c0 < self.cols {
-                let c1 = (c0 + CELL_CHUNK).min(self.cols);
+            let last = within.x1.min(self.cols);
+            let mut c0 = within.x0;
+            while c0 < last {
+                let c1 = (c0 + CELL_CHUNK).min(last);
                 let mut best = [(min2, 0i32, 0i32); CELL_CHUNK];
                 let mut y = odd(y0);
                 while y < y1 {
@@ -270,29 +319,39 @@ impl<'b> EdgeMap<'b> {
         }
     }
 
-    /// The 3-4 chamfer distance transform of one bin's plane, in place (two passes).
+    /// The 3-4 chamfer distance transform of one bin's plane within the cells found, in
+    /// place (two passes); the cells beyond stay as far as they were filled.
     fn transform(&mut self, bin: usize) {
-        let cols = self.cols;
+        let (cols, rows) = (self.cols, self.rows);
+        let r = self.within;
+        let (x0, x1, y1) = (r.x0, r.x1.min(cols), r.y1.min(rows));
         let plane = self.plane(bin);
-        if cols == 0 {
+        if x0 >= x1 || r.y0 >= y1 {
             return;
         }
         // Forward: from the left and the row above.
-        for y in 0..plane.len() / cols {
+        for y in r.y0..y1 {
             let (above, rest) = plane.split_at_mut(y * cols);
-            let Some(row) = rest.get_mut(..cols) else {
+            let Some(row) = rest.get_mut(x0..x1) else {
                 return;
             };
-            let prev = above.get(above.len().saturating_sub(cols)..).unwrap_or(&[]);
+            let prev = match y.checked_sub(1) {
+                Some(p) if y > r.y0 => above.get(p * cols + x0..p * cols + x1).unwrap_or(&[]),
+                _ => &[],
+            };
             relax_row(row, prev, 1);
         }
         // Backward: from the right and the row below.
-        for y in (0..plane.len() / cols).rev() {
+        for y in (r.y0..y1).rev() {
             let (head, below) = plane.split_at_mut((y + 1) * cols);
-            let Some(row) = head.get_mut(y * cols..) else {
+            let Some(row) = head.get_mut(y * cols + x0..y * cols + x1) else {
                 return;
             };
-            let next = below.get(..cols).unwrap_or(&[]);
+            let next = if y + 1 < y1 {
+                below.get(x0..x1).unwrap_or(&[])
+            } else {
+                &[]
+            };
             relax_row(row, next, -1);
         }
     }
@@ -497,6 +556,7 @@ mod tests {
                 stride_px: usize::from(s),
                 edge_cells: 0,
                 region: None,
+                within: CellRect::all(cols, rows),
             };
             let mut region = RegionBuilder::new(w, h);
             map.mark_edges(&frame, config.min_gradient, &mut region);
@@ -568,6 +628,7 @@ mod tests {
                 stride_px: 4,
                 edge_cells: edges as u32,
                 region: None,
+                within: CellRect::all(cols, rows),
             };
             map.transform(0);
             for y in 0..rows {
@@ -622,6 +683,94 @@ mod tests {
             assert!(with.edge_cells > 0);
             assert_eq!(without.cells(), with.cells());
             assert_eq!(without.dist, with.dist, "stride {stride_px}");
+        }
+    }
+
+    #[test]
+    fn a_map_built_for_some_reads_reads_there_as_the_whole_frames_map() {
+        let (w, h) = (203usize, 151usize);
+        let mut pixels = vec![0u8; w * h];
+        let mut seed = 777u32;
+        let mut next = || {
+            seed = seed.wrapping_mul(1_103_515_245).wrapping_add(12_345);
+            seed >> 16
+        };
+        for y in 0..h {
+            for x in 0..w {
+                let (dx, dy) = (x as i32 - 90, y as i32 - 70);
+                let blob = if dx * dx + 3 * dy * dy < 2_500 {
+                    140
+                } else {
+                    0
+                };
+                let stripe = if (x / 9) % 4 == 0 { 60 } else { 0 };
+                pixels[y * w + x] = (15 + next() % 30 + blob + stripe).min(255) as u8;
+            }
+        }
+        let frame = FrameView::packed(&pixels, w, h).unwrap();
+        let boxes = [
+            (60.0, 40.0, 120.0, 100.0),
+            (-30.0, 100.0, 20.0, 400.0),
+            (150.5, 3.2, 202.9, 20.1),
+            (0.0, 0.0, 0.0, 0.0),
+        ];
+        for stride_px in [1u8, 2, 3, 4, 5] {
+            for cap in [6.0f32, 24.0, 40.0] {
+                let config = LikelihoodConfig {
+                    stride_px,
+                    chamfer_cap_px: cap,
+                    ..LikelihoodConfig::default()
+                };
+                let needed = EdgeMap::bytes_needed(w, h, stride_px);
+                let mut whole = vec![0u8; needed];
+                let full = EdgeMap::build_edges(&mut whole, &frame, &config).unwrap();
+                for &(x0, y0, x1, y1) in &boxes {
+                    let bounds = crate::projection::Bounds {
+                        min: Vector2::new(x0, y0),
+                        max: Vector2::new(x1, y1),
+                    };
+                    let reads = Reads::Within(bounds);
+                    let mut part = vec![0u8; needed];
+                    let map = EdgeMap::build_edges_for(&mut part, &frame, &config, reads).unwrap();
+                    assert!(map.built(&frame, &config).covers(&reads, &config));
+                    assert!(!map
+                        .built(&frame, &config)
+                        .covers(&Reads::Everywhere, &config));
+                    // Every point within the bounds: the truncated distance of every bin.
+                    let s = f32::from(stride_px);
+                    let mut y = y0.max(0.0);
+                    while y <= y1 {
+                        let mut x = x0.max(0.0);
+                        while x <= x1 {
+                            let p = Vector2::new(x, y);
+                            for bin in 0..EDGE_BINS {
+                                let a = map.distance_px(bin, &p).map(|d| d.min(cap));
+                                let b = full.distance_px(bin, &p).map(|d| d.min(cap));
+                                assert_eq!(a, b, "stride {stride_px} cap {cap} at {p:?}");
+                            }
+                            x += s * 0.5;
+                        }
+                        y += s * 0.5;
+                    }
+                    // Every mark the reverse term can visit: the bounds widened by its margin
+                    // and the cell it rounds up to.
+                    let m = config.reverse_margin_px + s;
+                    let mut y = (y0 - m).max(0.0);
+                    while y <= y1 + m {
+                        let mut x = (x0 - m).max(0.0);
+                        while x <= x1 + m {
+                            let p = Vector2::new(x, y);
+                            for bin in 0..EDGE_BINS {
+                                let a = map.distance_units(bin, &p) == Some(0);
+                                let b = full.distance_units(bin, &p) == Some(0);
+                                assert_eq!(a, b, "mark, stride {stride_px} at {p:?}");
+                            }
+                            x += s;
+                        }
+                        y += s;
+                    }
+                }
+            }
         }
     }
 

@@ -16,6 +16,7 @@ use crate::frame::FrameView;
 use crate::projection::ProjectedModel;
 
 mod edges;
+mod reads;
 mod region;
 mod reverse;
 mod samples;
@@ -23,6 +24,7 @@ mod scene;
 mod state;
 
 pub use edges::{BuiltEdges, EdgeMap, EDGE_BINS, GRADIENT_STEP_PX};
+pub use reads::{reach_cells, CellRect, Reads};
 pub use region::{Region, EXTENT_PERCENTILE, MAX_EXTENT_BINS, MIN_REGION_SAMPLES};
 pub use reverse::MAX_REVERSE_CELLS;
 use samples::ChamferSum;

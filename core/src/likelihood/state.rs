@@ -11,8 +11,9 @@ use crate::projection::ProjectedModel;
 
 use super::{
     add_reverse, add_silhouette, ceiling, evaluate, evaluate_edges, reverse, Likelihood,
-    LikelihoodConfig, Scene,
+    LikelihoodConfig, Reads, Scene,
 };
+use crate::silhouette::hand_bounds;
 
 /// Shortest link drawn when scoring (px): the tracker's own default.
 pub const MIN_LINK_PX: f32 = 4.0;
@@ -54,6 +55,22 @@ impl StateScorer {
                 true
             }
             None => false,
+        }
+    }
+
+    /// Adds where scoring `q` (one value per model state) reads each camera's edge map to
+    /// `reads` (one per camera): its hand's image bounds there
+    /// ([`crate::silhouette::hand_bounds`]). A state that cannot be posed is scored without
+    /// reading any map, so it adds nothing.
+    pub fn add_reads(&mut self, model: &Model, cameras: &[Camera], q: &[f32], reads: &mut [Reads]) {
+        if !self.pose(model, q) {
+            return;
+        }
+        for (camera, r) in cameras.iter().zip(reads.iter_mut()) {
+            if !self.project(model, camera) {
+                return;
+            }
+            *r = r.with(hand_bounds(&self.view));
         }
     }
 
