@@ -145,23 +145,13 @@ impl<'b> EdgeMap<'b> {
         Ok(map)
     }
 
-    /// [`EdgeMap::build`] without the bright region (`region` is `None`): the same distance
-    /// maps, bit for bit, for a scorer, which never reads the region. The region's histogram
-    /// and its second pass over the frame are about a fifth of a build's instructions (1.6 M
-    /// of 7.4 M at 640×480 on x86-64).
-    #[inline(never)] // a stage of the loop: kept whole so profiles can attribute its cost
-    pub fn build_edges(
-        buffer: &'b mut [u8],
-        frame: &FrameView<'_>,
-        config: &LikelihoodConfig,
-    ) -> Result<Self, LikelihoodError> {
-        Self::build_marking(buffer, frame, config, Reads::Everywhere, &mut NoGreyLevels)
-    }
-
-    /// [`EdgeMap::build_edges`] for a score that reads the map only as `reads` says, under
-    /// `config`: only the cells such reads depend on are found ([`Reads::cells`]), and those
-    /// reads return what they would on the whole frame's map, bit for bit. A hand a third of
-    /// a 640×480 frame wide needs about a fifth of its cells.
+    /// [`EdgeMap::build`] without the bright region (`region` is `None`), for a score, which
+    /// never reads the region, and only over the cells a score that reads the map as `reads`
+    /// says depends on ([`Reads::cells`]; [`Reads::Everywhere`]: every cell). Those reads
+    /// return what they would on [`EdgeMap::build`]'s map, bit for bit. The region's histogram
+    /// and its second pass are about a fifth of a build (1.6 M of 7.4 M instructions at
+    /// 640×480 on x86-64), and a hand a third of a 640×480 frame wide reads about a fifth of
+    /// its cells.
     #[inline(never)] // a stage of the loop: kept whole so profiles can attribute its cost
     pub fn build_edges_for(
         buffer: &'b mut [u8],
@@ -386,7 +376,7 @@ impl<'b> EdgeMap<'b> {
 }
 
 /// Where [`EdgeMap::mark_edges`] puts each sampled grey level: the region's histogram, or
-/// nowhere ([`EdgeMap::build_edges`]). A type, not a flag, so the pass without the region has
+/// nowhere ([`EdgeMap::build_edges_for`]). A type, not a flag, so the pass without the region has
 /// no test in its inner loop.
 trait GreyLevels {
     fn add(&mut self, grey: i32);
@@ -676,7 +666,8 @@ mod tests {
             let needed = EdgeMap::bytes_needed(w, h, stride_px);
             let (mut full, mut edges) = (vec![7u8; needed], vec![9u8; needed]);
             let with = EdgeMap::build(&mut full, &frame, &config).unwrap();
-            let without = EdgeMap::build_edges(&mut edges, &frame, &config).unwrap();
+            let without =
+                EdgeMap::build_edges_for(&mut edges, &frame, &config, Reads::Everywhere).unwrap();
             assert!(with.region.is_some(), "the blob is a region");
             assert_eq!(without.region, None);
             assert_eq!(without.edge_cells, with.edge_cells);
@@ -723,7 +714,8 @@ mod tests {
                 };
                 let needed = EdgeMap::bytes_needed(w, h, stride_px);
                 let mut whole = vec![0u8; needed];
-                let full = EdgeMap::build_edges(&mut whole, &frame, &config).unwrap();
+                let full = EdgeMap::build_edges_for(&mut whole, &frame, &config, Reads::Everywhere)
+                    .unwrap();
                 for &(x0, y0, x1, y1) in &boxes {
                     let bounds = crate::projection::Bounds {
                         min: Vector2::new(x0, y0),
