@@ -243,15 +243,6 @@ enum LocalStart {
     Placed,
 }
 
-/// The pixels of the largest camera's frames.
-fn largest_frame_pixels(cameras: &[Camera]) -> usize {
-    cameras
-        .iter()
-        .map(|c| c.width as usize * c.height as usize)
-        .max()
-        .unwrap_or(0)
-}
-
 /// `state` (one value per model state) in a whole state's array, the rest 0.
 fn padded(state: &[f32]) -> [f32; MAX_STATES] {
     let mut q = [0.0f32; MAX_STATES];
@@ -405,7 +396,7 @@ impl AutoTracker {
             pursued: None,
             local_in_view: 0,
             recovery: Recovery::Search,
-            watch: Watch::new(WatchConfig::default(), largest_frame_pixels(cameras)),
+            watch: Watch::new(WatchConfig::default()),
             vouched: heapless::Vec::new(),
             hypotheses: HypothesesConfig::default(),
             confirm_left: 0,
@@ -463,7 +454,7 @@ impl AutoTracker {
 
     /// Sets how the image checks the track ([`crate::watch`]; `every_frames` 0: never).
     pub fn set_watch(&mut self, config: WatchConfig) {
-        self.watch = Watch::new(config, largest_frame_pixels(self.multi.tracker().cameras()));
+        self.watch = Watch::new(config);
     }
 
     /// Sets what happens once the hand is lost for [`LOST_FRAMES_BEFORE_SEARCH`] frames.

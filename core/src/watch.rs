@@ -24,19 +24,16 @@
 //! unexplained (the reverse chamfer term, [`WatchConfig::max_reverse_px`]); off by default:
 //! it flagged right tracks too (docs/robustness.md, "The reverse term as a bar of the watch").
 
-/// The frame size (px) at which a check falls due every [`WatchConfig::every_frames`]
-/// frames: 320×240.
-pub const WATCH_REFERENCE_PIXELS: usize = 320 * 240;
-
 /// When and how strictly the track is checked.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct WatchConfig {
-    /// A tracking frame of [`WATCH_REFERENCE_PIXELS`] is checked once every this many
-    /// (0: never checked); larger frames proportionally less often. The check builds each
-    /// camera's edge map, whose cost grows with the pixels while a tracking frame's does not:
-    /// at 320×240 a check costs about 1.5 whole-hand tracking frames, at 640×480 about 6
-    /// (docs/performance.md), so the period keeps the watch near a fifth of the tracking.
+    /// A tracking frame is checked once every this many (0: never checked), whatever the
+    /// frame's size. A check builds each camera's edge map over the cells around the tracked
+    /// hand only, so its cost follows the hand's size in the image, not the frame's: a quarter
+    /// to a third of a whole-hand tracking frame at 640×480 (docs/performance.md, "Edge maps
+    /// for a score"). (Before stop 61 a check built the whole frame's maps, and larger frames
+    /// were checked proportionally less often: every 32 frames at 640×480.)
     pub every_frames: u8,
     /// How far (likelihood units, 0..=1) the worst camera's score may fall under the
     /// track's reference.
@@ -85,14 +82,11 @@ pub struct Watch {
 }
 
 impl Watch {
-    /// A watch that checks as `config` says, on frames of `pixels` pixels (the largest
-    /// camera's).
-    pub fn new(config: WatchConfig, pixels: usize) -> Self {
-        let scale = pixels.div_ceil(WATCH_REFERENCE_PIXELS).max(1);
-        let period = usize::from(config.every_frames).saturating_mul(scale);
+    /// A watch that checks as `config` says.
+    pub fn new(config: WatchConfig) -> Self {
         Watch {
             config,
-            period_frames: u16::try_from(period).unwrap_or(u16::MAX),
+            period_frames: u16::from(config.every_frames),
             since_check: 0,
             doubted: false,
             reference: None,
@@ -171,23 +165,18 @@ mod tests {
     use super::*;
 
     fn every(n: u8) -> Watch {
-        Watch::new(
-            WatchConfig {
-                every_frames: n,
-                max_drop: 0.1,
-                ..WatchConfig::default()
-            },
-            WATCH_REFERENCE_PIXELS,
-        )
+        Watch::new(WatchConfig {
+            every_frames: n,
+            max_drop: 0.1,
+            ..WatchConfig::default()
+        })
     }
 
     #[test]
-    fn larger_frames_are_checked_proportionally_less_often() {
-        let config = WatchConfig::default();
-        assert_eq!(Watch::new(config, 160 * 120).period_frames(), 8);
-        assert_eq!(Watch::new(config, 320 * 240).period_frames(), 8);
-        assert_eq!(Watch::new(config, 640 * 480).period_frames(), 32);
-        assert_eq!(Watch::new(config, usize::MAX).period_frames(), u16::MAX);
+    fn the_period_is_the_configured_one() {
+        assert_eq!(Watch::new(WatchConfig::default()).period_frames(), 8);
+        assert_eq!(every(0).period_frames(), 0);
+        assert_eq!(every(u8::MAX).period_frames(), 255);
     }
 
     #[test]
@@ -246,15 +235,12 @@ mod tests {
 
     /// A watch checking every frame with a bar on the reverse term.
     fn reverse_barred(max_reverse_px: f32, reverse_min_drop: f32) -> Watch {
-        Watch::new(
-            WatchConfig {
-                every_frames: 1,
-                max_reverse_px,
-                reverse_min_drop,
-                ..WatchConfig::default()
-            },
-            WATCH_REFERENCE_PIXELS,
-        )
+        Watch::new(WatchConfig {
+            every_frames: 1,
+            max_reverse_px,
+            reverse_min_drop,
+            ..WatchConfig::default()
+        })
     }
 
     #[test]

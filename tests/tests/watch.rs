@@ -65,8 +65,9 @@ fn a_right_track_of_another_renderer_is_never_flagged() {
 fn a_track_the_image_no_longer_supports_is_flagged() {
     // Seed 76 (a stereo rig of the robustness sweep, 640x480), tracked without the palm's
     // outline edges: from frame ~59 the track settles on wrong fingers while the tracker's
-    // own flag stays down. At 640x480 a check falls due every 32 frames, so the watch removes
-    // a third or more of those frames (measured: 30 -> 17), not all. (With the palm edges,
+    // own flag stays down. The watch removes a third or more of those frames (measured:
+    // 32 -> 17, whether a check falls due every 32 frames, as at 640x480 before stop 61, or
+    // every 8, as at every size since), not all. (With the palm edges,
     // the default, this seed is tracked right to frame 90 and no sweep seed offers a wrong
     // track the watch catches: docs/robustness.md.) Rendered under the fixed light this case
     // was found under, not the lighting the sweep now draws for the seed.
