@@ -93,7 +93,8 @@ pub struct EdgeMap<'b> {
     cols: usize,
     rows: usize,
     stride_px: usize,
-    /// Edge cells marked (over all bins).
+    /// Edge cells marked (over all bins), among the cells found (every cell of a map built
+    /// for the search or for [`Reads::Everywhere`]).
     pub edge_cells: u32,
     /// The frame's bright region (the hand is brighter than the background), when the frame
     /// has one.
