@@ -41,6 +41,8 @@ pub struct RefineOverrides {
     /// The prior toward the predicted state: after [`Tracker::restart_fresh`], toward the
     /// start itself.
     pub prior: PriorWeights,
+    /// Gauss–Newton iterations at most (0: the tracker's own [`TrackerConfig::iterations`]).
+    pub iterations: u8,
 }
 
 /// The cameras, if there are 1 to [`MAX_CAMERAS`] and each is usable.
@@ -273,7 +275,7 @@ impl Tracker {
     }
 
     /// [`Tracker::track`] under `overrides` instead of the configured robust weight, edge
-    /// test, step and prior, which are back in place afterwards, error or not: a search
+    /// test, step, prior and iterations, which are back in place afterwards, error or not: a search
     /// refines its leaves under its own ([`FinderConfig::leaf_overrides`](crate::acquire::FinderConfig::leaf_overrides)).
     pub fn track_under(
         &mut self,
@@ -285,6 +287,9 @@ impl Tracker {
         self.config.features.max_edge_angle_rad = overrides.max_edge_angle_rad;
         self.config.estimator.bounded_step = overrides.bounded_step;
         self.config.motion.prior = overrides.prior;
+        if overrides.iterations > 0 {
+            self.config.iterations = overrides.iterations;
+        }
         let report = self.track(frames);
         self.config = own;
         report

@@ -168,6 +168,7 @@ fn track_under_puts_the_trackers_own_settings_back_error_or_not() {
         max_edge_angle_rad: 1.5,
         bounded_step: true,
         prior: PriorWeights::OFF,
+        iterations: own.iterations + 3,
     };
     assert_ne!(
         overrides.prior, own.motion.prior,
@@ -208,6 +209,7 @@ fn a_leafs_refinement_keeps_the_share_of_the_prior_its_rig_is_given() {
     assert_eq!(stereo.robust, finder.leaf_robust);
     assert_eq!(stereo.max_edge_angle_rad, finder.leaf_max_edge_angle_rad);
     assert_eq!(stereo.bounded_step, finder.leaf_bounded_step);
+    assert_eq!(stereo.iterations, finder.refine_iterations);
     assert_eq!(finder.local_overrides(&own).prior, PriorWeights::OFF);
     // A share that is not one: not a number keeps the tracker's own, beyond 1 is 1.
     let odd = FinderConfig {

@@ -302,6 +302,7 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
         leaves_per_frame: args.leaves_per_frame.unwrap_or(f.leaves_per_frame),
         leaves: args.leaves.unwrap_or(f.leaves),
         passes_per_leaf: args.passes.unwrap_or(f.passes_per_leaf),
+        refine_iterations: f.refine_iterations,
         accept: AcceptConfig {
             min_score: args.min_score.unwrap_or(f.accept.min_score),
             min_camera_score: args.min_camera_score.unwrap_or(f.accept.min_camera_score),

@@ -209,6 +209,54 @@ fn a_capped_frame_takes_at_most_its_iterations_and_the_own_number_returns() {
     assert_eq!(*capped.config(), own);
 }
 
+/// A search's refinement runs its own number of Gauss–Newton iterations
+/// ([`FinderConfig::refine_iterations`]) whatever the tracker's, and the tracker's own number
+/// is back afterwards; 0 leaves the tracker's.
+#[test]
+fn a_refinement_takes_the_searchs_iterations_not_the_trackers() {
+    use digiteyes_core::acquire::FinderConfig;
+    let dir = tempfile::tempdir().unwrap();
+    let seq = Sequence::open(&common::mouse(dir.path(), 6)).unwrap();
+    let initial: Vec<f32> = seq.initial_state.iter().map(|&v| v as f32).collect();
+    let mut own = TrackerConfig::default();
+    own.iterations = 2;
+    let mut t = Tracker::new(
+        seq.model.clone(),
+        &seq.cameras,
+        &initial,
+        seq.free_mask(),
+        own,
+    )
+    .unwrap();
+    let finder = FinderConfig::default();
+    assert!(finder.refine_iterations > own.iterations);
+    let search = finder.leaf_overrides(&own, seq.cameras.len());
+    let tracker_own = digiteyes_core::tracker::RefineOverrides {
+        iterations: 0,
+        ..search
+    };
+    // Each frame starts 12 mm off the hand, as a leaf does, so it needs more than two.
+    let mut start = initial.clone();
+    start[4] += 12.0;
+    let (mut longest, mut longest_own) = (0, 0);
+    for k in 0..seq.frames {
+        let image = seq.read_frame(0, k).unwrap();
+        t.restart_fresh(&start).unwrap();
+        let r = t.track_under(&search, &[view(&image)]).unwrap();
+        assert!(r.iterations <= finder.refine_iterations, "frame {k}");
+        longest = longest.max(r.iterations);
+        assert_eq!(*t.config(), own, "frame {k}");
+        t.restart_fresh(&start).unwrap();
+        let r = t.track_under(&tracker_own, &[view(&image)]).unwrap();
+        longest_own = longest_own.max(r.iterations);
+    }
+    assert!(
+        longest > own.iterations,
+        "the search's own number: {longest}"
+    );
+    assert_eq!(longest_own, own.iterations, "0: the tracker's own");
+}
+
 /// The carried hypotheses other than the best are tracked with at most `other_iterations`,
 /// the best with the tracker's own number.
 #[test]

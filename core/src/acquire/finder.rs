@@ -28,6 +28,11 @@ pub struct FinderConfig {
     /// Times the tracker runs on the frame from each leaf (each up to its iteration limit):
     /// a leaf farther than one frame's iterations reach converges in the next.
     pub passes_per_leaf: u8,
+    /// Gauss–Newton iterations at most in each pass of a leaf's or a local re-acquisition's
+    /// start's refinement, whatever the tracker's own [`TrackerConfig::iterations`] (0: the
+    /// tracker's). A leaf starts farther from the hand than a tracked frame's prediction, and
+    /// the search's bars were set on leaves refined by 8.
+    pub refine_iterations: u8,
     /// The acceptance thresholds.
     pub accept: AcceptConfig,
     /// Re-place each leaf on the bright region of the frame it is refined on before
@@ -252,6 +257,7 @@ impl FinderConfig {
                 translation: own.translation * share,
                 joint: own.joint * share,
             },
+            iterations: self.refine_iterations,
         }
     }
 }
@@ -262,6 +268,7 @@ impl Default for FinderConfig {
             leaves_per_frame: 2,
             leaves: 4,
             passes_per_leaf: 2,
+            refine_iterations: 8,
             accept: AcceptConfig::default(),
             replace_leaves: true,
             confirm_frames: 5,

@@ -72,6 +72,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "pt" => c.motion.prior.translation = f,
             "pq" => c.motion.prior.quaternion = f,
             "iters" => c.iterations = f as u8,
+            "liters" => o.finder.refine_iterations = f as u8,
             "predict" => c.predict = f != 0.0,
             "window" => c.features.window_px = f as u8,
             "slices" => c.features.slices_per_link = f as u8,

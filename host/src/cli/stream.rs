@@ -66,8 +66,8 @@ pub struct StreamArgs {
     /// The camera of a multi-camera sequence to track (0-based).
     #[arg(long, value_name = "N")]
     pub camera_index: Option<usize>,
-    /// Gauss–Newton iterations per frame, 1 to 50 (default: the tracker's, 8; the thesis
-    /// ran one per frame).
+    /// Gauss–Newton iterations per tracked frame, 1 to 50 (default: the tracker's, 8; the
+    /// thesis ran one per frame). The search's refinements keep their own 8.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(1..=50))]
     pub iterations: Option<u8>,
     /// How the board starts: `given` tracks from sequence.json's initial_state; `auto`

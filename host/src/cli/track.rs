@@ -56,7 +56,8 @@ pub struct TrackArgs {
     /// Output CSV path (default: states.csv in the current folder).
     #[arg(long, short, default_value = "states.csv", hide_default_value = true)]
     pub out: PathBuf,
-    /// Gauss–Newton iterations per frame (default: the tracker's).
+    /// Gauss–Newton iterations per tracked frame (default: the tracker's, 8). The search's
+    /// refinements of its leaves keep their own 8, which its acceptance was set on.
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..))]
     pub iterations: Option<u8>,
     /// Start each frame from the last estimate instead of a constant-velocity prediction.
