@@ -275,8 +275,9 @@ impl Tracker {
     }
 
     /// [`Tracker::track`] under `overrides` instead of the configured robust weight, edge
-    /// test, step, prior and iterations, which are back in place afterwards, error or not: a search
-    /// refines its leaves under its own ([`FinderConfig::leaf_overrides`](crate::acquire::FinderConfig::leaf_overrides)).
+    /// test, step, prior and iterations, which are back in place afterwards, error or not: a
+    /// search refines its leaves under its own
+    /// ([`FinderConfig::leaf_overrides`](crate::acquire::FinderConfig::leaf_overrides)).
     pub fn track_under(
         &mut self,
         overrides: &RefineOverrides,
