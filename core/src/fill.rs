@@ -29,6 +29,7 @@ use heapless::Vec;
 use nalgebra::Vector2;
 
 use crate::camera::Camera;
+use crate::config::MAX_LINKS;
 use crate::float::Length;
 use crate::frame::FrameView;
 use crate::projection::{ProjectedLink, ProjectedModel};
@@ -182,9 +183,17 @@ impl FillPoints {
 
 /// The link of `view` whose capsule covers `p` most deeply (by distance from its axis as a
 /// share of its radius), or [`PALM`] / [`UNCOVERED`].
-fn cover_class(view: &ProjectedModel, camera: &Camera, p: &Vector2<f32>) -> u8 {
+///
+/// Only the links in `among` (indices into `view.links`, ascending) are looked at: the
+/// answer is the same as over every link when `among` holds every link whose bounds contain
+/// `p` ([`links_across`]).
+fn cover_class(view: &ProjectedModel, camera: &Camera, among: &[u8], p: &Vector2<f32>) -> u8 {
     let mut best = (UNCOVERED, 1.0f32);
-    for (index, link) in view.links.iter().enumerate() {
+    for &index in among {
+        let index = usize::from(index);
+        let Some(link) = view.links.get(index) else {
+            continue;
+        };
         if !link.bounds.contains(p) {
             continue;
         }
@@ -203,6 +212,18 @@ fn cover_class(view: &ProjectedModel, camera: &Camera, p: &Vector2<f32>) -> u8 {
         return PALM;
     }
     best.0
+}
+
+/// The links of `view` whose bounds span image row `y` (px), in order: every link whose
+/// bounds contain a point of that row is among them.
+fn links_across(view: &ProjectedModel, y: f32) -> Vec<u8, MAX_LINKS> {
+    let mut out = Vec::new();
+    for (index, link) in view.links.iter().enumerate() {
+        if y >= link.bounds.min.y && y <= link.bounds.max.y {
+            let _ = out.push(index as u8);
+        }
+    }
+    out
 }
 
 /// The nearest link outline to `p` within `reach_px`, by the distance beyond its capsule.
@@ -259,12 +280,13 @@ pub fn gather(
     let mut sum = [0.0f32; 2];
     let mut count = [0u32; 2];
     for j in 0..grid {
+        let across = links_across(view, at(0, j).y);
         for i in 0..grid {
             let p = at(i, j);
             let Some(v) = frame.sample(p.x, p.y) else {
                 continue;
             };
-            let c = cover_class(view, camera, &p);
+            let c = cover_class(view, camera, &across, &p);
             let k = usize::from(c != UNCOVERED);
             value[j * grid + i] = (v + 0.5) as u8;
             class[j * grid + i] = c;
@@ -304,5 +326,68 @@ pub fn gather(
                 });
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinematics::Poses;
+    use crate::model::Model;
+    use nalgebra::{Matrix3, Vector3};
+
+    /// A 640×480 camera above a palm-down hand, looking down at 45°.
+    fn camera() -> Camera {
+        let h = core::f32::consts::FRAC_1_SQRT_2;
+        Camera {
+            width: 640,
+            height: 480,
+            fx: 1000.0,
+            fy: 1000.0,
+            cx: 319.5,
+            cy: 239.5,
+            r: Matrix3::new(h, -h, 0.0, -0.5, -0.5, -h, 0.5, 0.5, -h),
+            t: Vector3::new(26.15406, 25.07026, 520.0828),
+        }
+    }
+
+    /// The covering link at every 2 px over the hand's grid, culled by row, is the one found
+    /// among all links, over poses whose fingers bend and cross over each other.
+    #[test]
+    fn the_links_across_a_row_cover_as_every_link_does() {
+        let model = Model::hand().unwrap();
+        let camera = camera();
+        let all: Vec<u8, MAX_LINKS> = (0..MAX_LINKS as u8).collect();
+        let mut compared = 0usize;
+        let mut covered = 0usize;
+        for k in 0..12 {
+            let mut q = [0.0f32; 28];
+            q[..7].copy_from_slice(&[0.05, 0.02, 0.9975, -0.07, 3.0, -2.0, 45.0]);
+            for (i, v) in q.iter_mut().enumerate().skip(7) {
+                *v = 0.1 * ((i * 7 + k * 13) % 17) as f32 - 0.3;
+            }
+            let poses = Poses::compute(&model, &q).unwrap();
+            let mut view = ProjectedModel::new();
+            view.update(&model, &poses, &camera, 1.0);
+            let bounds = hand_bounds(&view).unwrap();
+            let mut y = bounds.min.y - 12.0;
+            while y <= bounds.max.y + 12.0 {
+                let across = links_across(&view, y);
+                let mut x = bounds.min.x - 12.0;
+                while x <= bounds.max.x + 12.0 {
+                    let p = Vector2::new(x, y);
+                    let culled = cover_class(&view, &camera, &across, &p);
+                    assert_eq!(culled, cover_class(&view, &camera, &all, &p), "{p:?}");
+                    compared += 1;
+                    covered += usize::from(culled != UNCOVERED && culled != PALM);
+                    x += 2.0;
+                }
+                y += 2.0;
+            }
+        }
+        assert!(
+            covered * 10 > compared,
+            "{covered} of {compared} points on a link"
+        );
     }
 }
