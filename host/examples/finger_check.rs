@@ -51,13 +51,6 @@ struct Args {
     single: bool,
 }
 
-/// The finger of each projected link (by its frame's last joint state), `None` for none.
-fn finger_of_frame(model: &Model, fingers: &Fingers, frame: usize) -> Option<usize> {
-    let chain = model.chain(frame)?;
-    let s = usize::from(*chain.last()?);
-    (0..fingers.count()).find(|&f| fingers.contains(f, s))
-}
-
 /// Per finger: bright share and chamfer; and the unexplained share, of one camera's view.
 struct Scores {
     bright: Vec<Option<f32>>,
@@ -105,7 +98,7 @@ fn score_view(
     let n = fingers.count();
     let mut bright_hits = vec![(0u32, 0u32); n];
     for (index, link) in view.links.iter().enumerate() {
-        let Some(f) = finger_of_frame(model, fingers, usize::from(link.frame)) else {
+        let Some(f) = kept::finger_of_frame(model, fingers, usize::from(link.frame)) else {
             continue;
         };
         let (among, palm) = candidates(view, index, &link.bounds);
@@ -135,7 +128,7 @@ fn score_view(
     // Per-finger chamfer: the likelihood's samples, grouped by the link they came from.
     let mut chamfer = vec![(0.0f32, 0u32); n];
     for (index, link) in view.links.iter().enumerate() {
-        let Some(f) = finger_of_frame(model, fingers, usize::from(link.frame)) else {
+        let Some(f) = kept::finger_of_frame(model, fingers, usize::from(link.frame)) else {
             continue;
         };
         let mut one = view.clone();
@@ -236,7 +229,7 @@ fn penetration(rig: &Rig<'_>, q: &[f32]) -> Option<Vec<f32>> {
     let n = rig.fingers.count();
     let mut depth = vec![0.0f32; n];
     let finger = |l: &digiteyes_core::projection::ProjectedLink| {
-        finger_of_frame(rig.model, rig.fingers, usize::from(l.frame))
+        kept::finger_of_frame(rig.model, rig.fingers, usize::from(l.frame))
     };
     for a in &view.links {
         let Some(fa) = finger(a) else { continue };
@@ -290,7 +283,7 @@ fn main() -> Result<()> {
         // Each finger's tip link.
         let tips: Vec<(usize, usize)> = (0..model.links().len())
             .filter(|&i| matches!(model.links()[i].shape, Shape::Tip { .. }))
-            .filter_map(|i| finger_of_frame(model, &fingers, i).map(|f| (f, i)))
+            .filter_map(|i| kept::finger_of_frame(model, &fingers, i).map(|f| (f, i)))
             .collect();
         for k in (1..truth.len().min(kept.len())).step_by(args.every.max(1)) {
             let images = kept::read_instant(&seq, k)?;

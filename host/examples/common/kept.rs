@@ -6,6 +6,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Result};
 use digiteyes_core::estimator::Robust;
 use digiteyes_core::frame::FrameView;
+use digiteyes_core::hypotheses::fingers::Fingers;
+use digiteyes_core::model::Model;
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::track::TrackOptions;
 use digiteyes_host::TrackerConfig;
@@ -148,4 +150,11 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
         }
     }
     Ok((c, o))
+}
+
+/// The finger of model frame `frame` (by its chain's last joint state), `None` for none.
+pub fn finger_of_frame(model: &Model, fingers: &Fingers, frame: usize) -> Option<usize> {
+    let chain = model.chain(frame)?;
+    let s = usize::from(*chain.last()?);
+    (0..fingers.count()).find(|&f| fingers.contains(f, s))
 }
