@@ -37,11 +37,14 @@ use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::{EdgeMap, Scene, StateScorer};
 use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::projection::ProjectedModel;
+use digiteyes_core::tracker::Tracker;
 use digiteyes_core::visibility::{cover, Cover};
 use digiteyes_host::eval::reprojection_error;
 use digiteyes_host::render::{Background, Lighting, RenderSettings, Renderer};
 use digiteyes_host::scenarios::{generate, RenderOptions};
 use digiteyes_host::sequence::{read_states, Sequence};
+use digiteyes_host::sequence_tracker;
+use digiteyes_host::TrackerConfig;
 use image::GrayImage;
 use nalgebra::{SMatrix, SVector};
 
@@ -57,7 +60,30 @@ struct Args {
     /// tracker's grid would), 1: every pixel.
     #[arg(long, default_value_t = 1)]
     lattice: usize,
+    /// Also re-search the wrong finger as a per-finger library would: its last three joint
+    /// states set to 1/6, 1/2 and 5/6 of their ranges (27 starts), each refined by one
+    /// tracker frame, and the best chosen by the fitted shading and by the likelihood; and the
+    /// same for one finger in turn of every other frame looked at where every tip is within
+    /// 3 px (does the re-search keep a right finger right?).
+    #[arg(long)]
+    library: bool,
 }
+
+/// One library case: the finger's tip error (px, worst camera) as kept, as chosen by
+/// the fitted shading, by the likelihood, and the best of the candidates.
+#[derive(Clone, Copy)]
+struct Chosen {
+    stereo: bool,
+    /// A finger of a hand that was right (every tip within 3 px), re-searched in turn.
+    right: bool,
+    kept: f64,
+    shading: f64,
+    likelihood: f64,
+    best: f64,
+}
+
+/// The three levels of a joint's range the library starts from.
+const LEVELS: [f32; 3] = [1.0 / 6.0, 0.5, 5.0 / 6.0];
 
 /// Sum of squared grey-level differences between two frames of one size.
 fn ssd(a: &GrayImage, b: &GrayImage) -> f64 {
@@ -163,6 +189,7 @@ fn main() -> Result<()> {
     let mut view = ProjectedModel::default();
     let likelihood = HypothesesConfig::default().likelihood;
     let mut scorer = StateScorer::new();
+    let mut chosen: Vec<Chosen> = Vec::new();
     for root in &args.dirs {
         for dir in kept::seed_dirs(root)? {
             let seed = kept::seed_of(&dir);
@@ -213,6 +240,14 @@ fn main() -> Result<()> {
             let states =
                 kept::f32s(&read_states(&dir.join("states.csv"), sequence.n_states())?.rows);
             let fingers = Fingers::of(model);
+            let mut tracker = sequence_tracker(&sequence, TrackerConfig::default())?;
+            let library = Library {
+                model,
+                sequence: &sequence,
+                fingers: &fingers,
+                bases: &bases,
+                lattice: args.lattice,
+            };
             let tips: Vec<(usize, usize)> = (0..model.links().len())
                 .filter(|&i| matches!(model.links()[i].shape, Shape::Tip { .. }))
                 .filter_map(|i| kept::finger_of_frame(model, &fingers, i).map(|f| (f, i)))
@@ -235,6 +270,21 @@ fn main() -> Result<()> {
                     .map(|&(f, _)| f)
                     .collect();
                 let right = tips.iter().filter(|&&(_, tip)| tip_err(tip) < 5.0).count();
+                let all_right = tips.iter().all(|&(_, tip)| tip_err(tip) < 3.0);
+                let turn = k / args.every.max(1);
+                if args.library && all_right && turn % 2 == 0 {
+                    // A right hand: does re-searching one of its fingers (in turn) keep it?
+                    let (f, tip) = tips[(turn / 2) % tips.len()];
+                    let case = Case {
+                        truth: &pt,
+                        state: &states[k],
+                        k,
+                        finger: f,
+                        tip,
+                        right: true,
+                    };
+                    chosen.push(library.choose(&mut tracker, &mut scorer, &case)?);
+                }
                 if wrong.len() != 1 || right + 1 != tips.len() {
                     continue;
                 }
@@ -280,28 +330,25 @@ fn main() -> Result<()> {
                 }
                 t.fitted += usize::from(fit[1] < fit[0]);
                 let frames = kept::views(&images)?;
-                let mut buffers: Vec<Vec<u8>> = frames
-                    .iter()
-                    .map(|f| {
-                        vec![
-                            0u8;
-                            EdgeMap::bytes_needed(f.width(), f.height(), likelihood.stride_px)
-                        ]
-                    })
-                    .collect();
-                let maps = buffers
-                    .iter_mut()
-                    .zip(&frames)
-                    .map(|(b, f)| {
-                        EdgeMap::build(b, f, &likelihood).map_err(|e| anyhow::anyhow!("{e}"))
-                    })
-                    .collect::<Result<Vec<_>>>()?;
+                let mut buffers = edge_buffers(&frames, &likelihood);
+                let maps = edge_maps(&mut buffers, &frames, &likelihood)?;
                 let scene = Scene::new(model, &sequence.cameras, &frames, &maps);
                 let (kept_score, fixed_score) = (
                     scorer.score(&scene, &states[k], &likelihood),
                     scorer.score(&scene, &fixed, &likelihood),
                 );
                 t.likelihood += usize::from(fixed_score > kept_score);
+                if args.library {
+                    let case = Case {
+                        truth: &pt,
+                        state: &states[k],
+                        k,
+                        finger: wrong[0],
+                        tip: tip.unwrap_or(usize::MAX),
+                        right: false,
+                    };
+                    chosen.push(library.choose(&mut tracker, &mut scorer, &case)?);
+                }
                 t.cases += 1;
                 t.shaded += usize::from(sh[1] < sh[0]);
                 t.flat += usize::from(fl[1] < fl[0]);
@@ -327,5 +374,171 @@ fn main() -> Result<()> {
             share(t.likelihood)
         );
     }
+    if args.library {
+        for (stereo, right) in [(false, false), (true, false), (false, true), (true, true)] {
+            let cases: Vec<&Chosen> = chosen
+                .iter()
+                .filter(|c| c.stereo == stereo && c.right == right)
+                .collect();
+            let n = cases.len().max(1) as f64;
+            let within =
+                |f: fn(&Chosen) -> f64| cases.iter().filter(|c| f(c) <= 10.0).count() as f64 / n;
+            let better = |f: fn(&Chosen) -> f64| {
+                cases.iter().filter(|c| f(c) < c.kept - 2.0).count() as f64 / n
+            };
+            let worse = |f: fn(&Chosen) -> f64| {
+                cases.iter().filter(|c| f(c) > c.kept + 2.0).count() as f64 / n
+            };
+            println!(
+                "library, {}, {}: {} cases; the finger's tip within 10 px: kept {:.2}, chosen by \
+                 shading {:.2} (better / worse by 2 px {:.2} / {:.2}), by the likelihood {:.2} \
+                 ({:.2} / {:.2}), the best candidate {:.2}",
+                if stereo { "stereo" } else { "mono" },
+                if right {
+                    "a right finger"
+                } else {
+                    "the wrong finger"
+                },
+                cases.len(),
+                within(|c| c.kept),
+                within(|c| c.shading),
+                better(|c| c.shading),
+                worse(|c| c.shading),
+                within(|c| c.likelihood),
+                better(|c| c.likelihood),
+                worse(|c| c.likelihood),
+                within(|c| c.best),
+            );
+        }
+    }
     Ok(())
+}
+
+/// One instant's edge-map buffers, one per camera.
+fn edge_buffers(
+    frames: &[digiteyes_core::frame::FrameView<'_>],
+    likelihood: &digiteyes_core::likelihood::LikelihoodConfig,
+) -> Vec<Vec<u8>> {
+    frames
+        .iter()
+        .map(|f| vec![0u8; EdgeMap::bytes_needed(f.width(), f.height(), likelihood.stride_px)])
+        .collect()
+}
+
+/// Each camera's edge map of `frames`, built in `buffers`.
+fn edge_maps<'a>(
+    buffers: &'a mut [Vec<u8>],
+    frames: &[digiteyes_core::frame::FrameView<'_>],
+    likelihood: &digiteyes_core::likelihood::LikelihoodConfig,
+) -> Result<Vec<EdgeMap<'a>>> {
+    buffers
+        .iter_mut()
+        .zip(frames)
+        .map(|(b, f)| EdgeMap::build(b, f, likelihood).map_err(|e| anyhow::anyhow!("{e}")))
+        .collect()
+}
+
+/// One seed, for a per-finger library's re-search.
+struct Library<'a> {
+    model: &'a Model,
+    sequence: &'a Sequence,
+    fingers: &'a Fingers,
+    bases: &'a [Bases],
+    lattice: usize,
+}
+
+/// One finger of one frame to re-search.
+struct Case<'a> {
+    /// The frame's true poses.
+    truth: &'a Poses,
+    /// The kept state.
+    state: &'a [f32],
+    /// The frame.
+    k: usize,
+    finger: usize,
+    /// The finger's tip frame.
+    tip: usize,
+    /// Whether the hand was right (every tip within 3 px).
+    right: bool,
+}
+
+impl Library<'_> {
+    /// Re-searches the case's finger: its last three joint states at every
+    /// combination of [`LEVELS`], each refined by one tracker frame, and the kept state; the
+    /// candidates chosen by the fitted shading and by the likelihood, and the best.
+    fn choose(
+        &self,
+        tracker: &mut Tracker,
+        scorer: &mut StateScorer,
+        at: &Case<'_>,
+    ) -> Result<Chosen> {
+        let likelihood = HypothesesConfig::default().likelihood;
+        let (finger, tip) = (at.finger, at.tip);
+        let images = kept::read_instant(self.sequence, at.k)?;
+        let frames = kept::views(&images)?;
+        let mut buffers = edge_buffers(&frames, &likelihood);
+        let maps = edge_maps(&mut buffers, &frames, &likelihood)?;
+        let scene = Scene::new(self.model, &self.sequence.cameras, &frames, &maps);
+        let finger_err = |q: &[f32]| -> Result<f64> {
+            let p = Poses::compute(self.model, q)?;
+            Ok(self
+                .sequence
+                .cameras
+                .iter()
+                .map(|c| reprojection_error(c, at.truth, &p, tip))
+                .fold(0.0f64, f64::max))
+        };
+        let joints: Vec<usize> = (0..at.state.len())
+            .filter(|&s| self.fingers.contains(finger, s))
+            .collect();
+        let mut candidates = vec![at.state.to_vec()];
+        for code in 0..27 {
+            let mut q = at.state.to_vec();
+            for (d, &s) in joints.iter().rev().take(3).enumerate() {
+                if let Some(limit) = self.model.limit(s) {
+                    let level = LEVELS[(code / 3usize.pow(d as u32)) % 3];
+                    q[s] = limit.lo + (limit.hi - limit.lo) * level;
+                }
+            }
+            candidates.push(refined(tracker, &frames, &q)?);
+        }
+        let (mut by_shading, mut by_likelihood) = ((f64::INFINITY, 0), (f32::MIN, 0));
+        let mut best = f64::INFINITY;
+        for (i, q) in candidates.iter().enumerate() {
+            let mut residual = 0.0;
+            for (basis, image) in self.bases.iter().zip(&images) {
+                residual += basis.residual(q, image, self.lattice)?;
+            }
+            if residual < by_shading.0 {
+                by_shading = (residual, i);
+            }
+            let score = scorer.score(&scene, q, &likelihood);
+            if score > by_likelihood.0 {
+                by_likelihood = (score, i);
+            }
+            best = best.min(finger_err(q)?);
+        }
+        Ok(Chosen {
+            stereo: self.sequence.cameras.len() > 1,
+            right: at.right,
+            kept: finger_err(&candidates[0])?,
+            shading: finger_err(&candidates[by_shading.1])?,
+            likelihood: finger_err(&candidates[by_likelihood.1])?,
+            best,
+        })
+    }
+}
+
+/// `start` refined by one tracker frame on `frames`, from rest (no velocity).
+fn refined(
+    tracker: &mut Tracker,
+    frames: &[digiteyes_core::frame::FrameView<'_>],
+    start: &[f32],
+) -> Result<Vec<f32>> {
+    let mut memory = tracker.memory();
+    memory.state = heapless::Vec::from_slice(start).map_err(|_| anyhow::anyhow!("states"))?;
+    memory.velocity = None;
+    tracker.restore(&memory)?;
+    tracker.track(frames)?;
+    Ok(tracker.state().to_vec())
 }
