@@ -183,11 +183,30 @@ pub struct ProjectedPalm {
 impl ProjectedPalm {
     /// Camera depth (mm) at which the ray through pixel `p` enters the palm box, if it does.
     pub fn depth_at(&self, camera: &Camera, p: &Vector2<f32>) -> Option<f32> {
+        self.enter(camera, p).map(|(depth, _)| depth)
+    }
+
+    /// Where the ray through pixel `p` enters the palm box, if it does: the camera depth (mm)
+    /// and the outward unit normal of the face it enters by, in camera coordinates. A ray
+    /// that starts inside the box (the camera in the palm) enters by no face: `None`.
+    pub fn hit_at(&self, camera: &Camera, p: &Vector2<f32>) -> Option<(f32, Vector3<f32>)> {
+        let (depth, (k, sign)) = self.enter(camera, p).and_then(|(d, f)| Some((d, f?)))?;
+        let mut normal = Vector3::zeros();
+        normal[k] = sign;
+        // `to_palm` is the rotation from camera to palm axes: its transpose maps back.
+        Some((depth, self.to_palm.transpose() * normal))
+    }
+
+    /// The slab test of the ray through pixel `p` against the box: the depth (mm) at which it
+    /// enters, and the face it enters by (palm axis, and −1 for the low face or +1 for the
+    /// high one), none when it starts inside.
+    fn enter(&self, camera: &Camera, p: &Vector2<f32>) -> Option<(f32, Option<(usize, f32)>)> {
         if !self.bounds.contains(p) {
             return None;
         }
         let dir = self.to_palm * camera.ray(p);
         let (mut t_in, mut t_out) = (0.0f32, f32::INFINITY);
+        let mut face = None;
         for k in 0..3 {
             if dir[k].abs() < 1e-12 {
                 if self.origin[k] < self.lo[k] || self.origin[k] > self.hi[k] {
@@ -197,10 +216,15 @@ impl ProjectedPalm {
             }
             let t1 = (self.lo[k] - self.origin[k]) / dir[k];
             let t2 = (self.hi[k] - self.origin[k]) / dir[k];
-            t_in = t_in.max(t1.min(t2));
+            let near = t1.min(t2);
+            if near > t_in {
+                t_in = near;
+                // Moving up axis k the ray enters by the low face, whose normal is −k.
+                face = Some((k, if dir[k] > 0.0 { -1.0 } else { 1.0 }));
+            }
             t_out = t_out.min(t1.max(t2));
         }
-        (t_in <= t_out).then_some(t_in)
+        (t_in <= t_out).then_some((t_in, face))
     }
 }
 

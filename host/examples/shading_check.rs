@@ -13,6 +13,8 @@
 //!   and coverage are rendered (blurred as the frame), and the background, the hand's mean
 //!   grey and a linear shading `c·n` fitted to the frame by least squares, per state; the
 //!   fit's squared residual is the score;
+//! - `core`: the core's own fit (`likelihood::shading::fit`) on a `--grid` lattice over the
+//!   projected hand, normals by ray casting in f32, no blur: the summed squared residual;
 //! - `likelihood`: the tracker's own image likelihood (`StateScorer::score`), as the
 //!   hypotheses weigh it (with the reverse chamfer term).
 //!
@@ -34,7 +36,7 @@ use clap::Parser;
 use digiteyes_core::hypotheses::fingers::Fingers;
 use digiteyes_core::hypotheses::HypothesesConfig;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::likelihood::{EdgeMap, Scene, StateScorer};
+use digiteyes_core::likelihood::{shading, EdgeMap, Scene, StateScorer};
 use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_core::tracker::Tracker;
@@ -60,6 +62,9 @@ struct Args {
     /// tracker's grid would), 1: every pixel.
     #[arg(long, default_value_t = 1)]
     lattice: usize,
+    /// The side of the core fit's lattice over the projected hand.
+    #[arg(long, default_value_t = 32)]
+    grid: usize,
     /// Also re-search the wrong finger as a per-finger library would: its last three joint
     /// states set to 1/6, 1/2 and 5/6 of their ranges (27 starts), each refined by one
     /// tracker frame, and the best chosen by the fitted shading and by the likelihood; and the
@@ -102,6 +107,7 @@ struct Tally {
     flat: usize,
     flat_ties: usize,
     fitted: usize,
+    core: usize,
     likelihood: usize,
 }
 
@@ -330,6 +336,18 @@ fn main() -> Result<()> {
                 }
                 t.fitted += usize::from(fit[1] < fit[0]);
                 let frames = kept::views(&images)?;
+                let mut core = [0.0f64; 2];
+                for (i, q) in [&states[k], &fixed].into_iter().enumerate() {
+                    let poses = Poses::compute(model, q)?;
+                    for (camera, frame) in sequence.cameras.iter().zip(&frames) {
+                        view.update(model, &poses, camera, 0.0);
+                        core[i] += shading::fit(&view, camera, frame, args.grid)
+                            .map_or(f64::INFINITY, |f| {
+                                f64::from(f.rms).powi(2) * f64::from(f.points)
+                            });
+                    }
+                }
+                t.core += usize::from(core[1] < core[0]);
                 let mut buffers = edge_buffers(&frames, &likelihood);
                 let maps = edge_maps(&mut buffers, &frames, &likelihood)?;
                 let scene = Scene::new(model, &sequence.cameras, &frames, &maps);
@@ -365,12 +383,13 @@ fn main() -> Result<()> {
         let share = |n: usize| n as f64 / t.cases.max(1) as f64;
         println!(
             "{rig}, {seen}: {} frames with one finger wrong; the finger at its true joints preferred by \
-             shaded {:.2}, flat {:.2} (ties {}), fitted {:.2}, likelihood {:.2}",
+             shaded {:.2}, flat {:.2} (ties {}), fitted {:.2}, core {:.2}, likelihood {:.2}",
             t.cases,
             share(t.shaded),
             share(t.flat),
             t.flat_ties,
             share(t.fitted),
+            share(t.core),
             share(t.likelihood)
         );
     }

@@ -21,6 +21,7 @@ mod region;
 mod reverse;
 mod samples;
 mod scene;
+pub mod shading;
 mod state;
 
 pub use edges::{BuiltEdges, EdgeMap, EDGE_BINS, GRADIENT_STEP_PX};
