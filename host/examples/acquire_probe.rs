@@ -43,9 +43,7 @@ use digiteyes_core::camera::Camera;
 use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::Robust;
 use digiteyes_core::frame::FrameView;
-use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig, Scene, StateScorer};
-use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::state::TRANSLATION;
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::bench::robustness::FAR_PALM_MM;
@@ -398,34 +396,6 @@ fn robust_weight(text: &str) -> Robust {
     }
 }
 
-/// Mean fingertip distance (px) between states `a` and `b` over every camera.
-fn tip_error_px(model: &Model, cameras: &[Camera], a: &[f32], b: &[f32]) -> f32 {
-    let (Ok(pa), Ok(pb)) = (Poses::compute(model, a), Poses::compute(model, b)) else {
-        return f32::INFINITY;
-    };
-    let tips: Vec<usize> = (0..model.links().len())
-        .filter(|&i| matches!(model.links()[i].shape, Shape::Tip { .. }))
-        .collect();
-    let (mut sum, mut n) = (0.0f32, 0u32);
-    for c in cameras {
-        for &t in &tips {
-            let (Some(x), Some(y)) = (pa.origin(t), pb.origin(t)) else {
-                continue;
-            };
-            match (c.project(&x), c.project(&y)) {
-                (Some(u), Some(v)) => sum += (u - v).norm(),
-                _ => sum += 1e3,
-            }
-            n += 1;
-        }
-    }
-    if n == 0 {
-        f32::INFINITY
-    } else {
-        sum / n as f32
-    }
-}
-
 /// One run's outcome.
 struct Run {
     acquired: Option<usize>,
@@ -652,7 +622,7 @@ fn step_frame(
         .map_err(|e| anyhow!("{e}"))?;
     let claimed = report.status != Status::Searching && !report.report.lost;
     let e = if claimed {
-        tip_error_px(&sequence.model, &sequence.cameras, auto.state(), truth_k)
+        kept::tip_error_px(&sequence.model, &sequence.cameras, auto.state(), truth_k)
     } else {
         f32::INFINITY
     };
@@ -702,7 +672,7 @@ fn run(
             if args.trace && report.accepted {
                 let by_leaf = auto.finder().last_leaf().is_some_and(|(v, _)| v.accepted);
                 let q = auto.tracker().state();
-                let e = tip_error_px(&sequence.model, &sequence.cameras, q, &truth_k);
+                let e = kept::tip_error_px(&sequence.model, &sequence.cameras, q, &truth_k);
                 eprintln!(
                     "acceptance {label} {k} {} score {:.3} tip {e:.1} px",
                     if by_leaf { "leaf" } else { "pursued" },
@@ -720,7 +690,7 @@ fn run(
                 let n = sequence.n_states();
                 let images = kept::read_instant(sequence, k)?;
                 let views = kept::views(&images)?;
-                let e = tip_error_px(&sequence.model, &sequence.cameras, &q[..n], &truth_k);
+                let e = kept::tip_error_px(&sequence.model, &sequence.cameras, &q[..n], &truth_k);
                 eprintln!(
                     "leaf {label} {k} accepted {} tip {e:.1} px {}",
                     u8::from(verdict.accepted),
@@ -729,7 +699,7 @@ fn run(
             }
             if let (Some((verdict, q)), Some(f)) = (auto.finder().last_leaf(), csv.as_mut()) {
                 let n = sequence.n_states();
-                let e = tip_error_px(&sequence.model, &sequence.cameras, &q[..n], &truth_k);
+                let e = kept::tip_error_px(&sequence.model, &sequence.cameras, &q[..n], &truth_k);
                 let images = kept::read_instant(sequence, k)?;
                 let views = kept::views(&images)?;
                 let fine = fine_columns(sequence, &views, &q[..n])?;
@@ -769,7 +739,7 @@ fn run(
                 .hypotheses()
                 .iter()
                 .map(|h| {
-                    let tip = tip_error_px(
+                    let tip = kept::tip_error_px(
                         &sequence.model,
                         &sequence.cameras,
                         &h.memory.state,
@@ -985,7 +955,7 @@ fn oracle_holds(sequence: &Sequence, start: usize, limit: f32) -> Result<bool> {
         let views = kept::views(&images)?;
         let report = tracker.track(&views).map_err(|e| anyhow!("{e}"))?;
         let t: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
-        let e = tip_error_px(&sequence.model, &sequence.cameras, tracker.state(), &t);
+        let e = kept::tip_error_px(&sequence.model, &sequence.cameras, tracker.state(), &t);
         if report.lost || e > limit {
             return Ok(false);
         }

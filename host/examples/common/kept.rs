@@ -4,10 +4,12 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
+use digiteyes_core::camera::Camera;
 use digiteyes_core::estimator::Robust;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::fingers::Fingers;
-use digiteyes_core::model::Model;
+use digiteyes_core::kinematics::Poses;
+use digiteyes_core::model::{Model, Shape};
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::track::TrackOptions;
 use digiteyes_host::TrackerConfig;
@@ -157,4 +159,32 @@ pub fn finger_of_frame(model: &Model, fingers: &Fingers, frame: usize) -> Option
     let chain = model.chain(frame)?;
     let s = usize::from(*chain.last()?);
     (0..fingers.count()).find(|&f| fingers.contains(f, s))
+}
+
+/// Mean fingertip distance (px) between states `a` and `b` over every camera.
+pub fn tip_error_px(model: &Model, cameras: &[Camera], a: &[f32], b: &[f32]) -> f32 {
+    let (Ok(pa), Ok(pb)) = (Poses::compute(model, a), Poses::compute(model, b)) else {
+        return f32::INFINITY;
+    };
+    let tips: Vec<usize> = (0..model.links().len())
+        .filter(|&i| matches!(model.links()[i].shape, Shape::Tip { .. }))
+        .collect();
+    let (mut sum, mut n) = (0.0f32, 0u32);
+    for c in cameras {
+        for &t in &tips {
+            let (Some(x), Some(y)) = (pa.origin(t), pb.origin(t)) else {
+                continue;
+            };
+            match (c.project(&x), c.project(&y)) {
+                (Some(u), Some(v)) => sum += (u - v).norm(),
+                _ => sum += 1e3,
+            }
+            n += 1;
+        }
+    }
+    if n == 0 {
+        f32::INFINITY
+    } else {
+        sum / n as f32
+    }
 }
