@@ -534,6 +534,9 @@ impl AutoTracker {
         edge_buffers: &mut [&mut [u8]],
     ) -> Result<AutoReport, AutoError> {
         let multi = self.track_hypotheses(frames, edge_buffers)?;
+        if !multi.report.lost {
+            self.refine_shading(frames)?;
+        }
         // The maps the hypotheses were scored on, if they were: each check below opens them
         // again instead of building its own (nothing else writes the buffers this frame).
         let built = self.multi.take_built_edges();
@@ -638,6 +641,16 @@ impl AutoTracker {
             &multi,
             watch_score,
         ))
+    }
+
+    /// A finger of the tracked state moved where the hand's shading says it lies
+    /// ([`Tracker::refine_shading`]; off by default).
+    #[inline(never)] // a stage of the status machine: kept whole so profiles can attribute its cost
+    fn refine_shading(&mut self, frames: &[FrameView<'_>]) -> Result<(), AutoError> {
+        self.multi
+            .refine_shading(frames)
+            .map_err(AutoError::Tracker)?;
+        Ok(())
     }
 
     /// The hand claimed (or about to be) was not the hand after all: the search goes on, the

@@ -19,7 +19,9 @@ use crate::estimator::{
 use crate::features::{FeatureConfig, LinkFeatures};
 use crate::fill::{FillConfig, FillPoints};
 use crate::frame::{FrameError, FrameView};
+use crate::hypotheses::fingers::Fingers;
 use crate::kinematics::{KinematicsError, Poses};
+use crate::likelihood::shading_refine::{refine_finger, RefineOutcome, ShadingRefineConfig};
 use crate::measurer::{LocalFrames, Measurer};
 use crate::model::Model;
 use crate::motion::{velocity_trust, MotionConfig, PriorWeights};
@@ -97,6 +99,9 @@ pub struct TrackerConfig {
     pub motion: MotionConfig,
     /// Region rows ([`crate::fill`]); on by default.
     pub fill: FillConfig,
+    /// A finger moved where the hand's shading says it lies, after a frame
+    /// ([`Tracker::refine_shading`]); off by default.
+    pub shading_refine: ShadingRefineConfig,
 }
 
 impl Default for TrackerConfig {
@@ -114,6 +119,7 @@ impl Default for TrackerConfig {
             estimator: EstimatorConfig::default(),
             motion: MotionConfig::default(),
             fill: FillConfig::default(),
+            shading_refine: ShadingRefineConfig::default(),
         }
     }
 }
@@ -218,6 +224,10 @@ pub struct Tracker {
     silhouette_reference: Option<f32>,
     free: FreeMask,
     config: TrackerConfig,
+    /// The model's fingers, for [`Tracker::refine_shading`].
+    fingers: Fingers,
+    /// Calls of [`Tracker::refine_shading`] so far: whose turn it is.
+    shading_calls: u32,
     work: Workspace,
 }
 
@@ -238,7 +248,10 @@ impl Tracker {
         }
         let mask = free.with_whole_quaternion();
         let poses = Poses::compute(&model, initial).map_err(TrackerError::State)?;
+        let fingers = Fingers::of(&model);
         let mut tracker = Tracker {
+            fingers,
+            shading_calls: 0,
             model,
             cameras,
             state: Vec::new(),
@@ -405,6 +418,12 @@ impl Tracker {
     /// Tracks one instant: `frames[i]` is camera `i`'s frame. Updates the state and reports.
     /// A frame of the wrong size is an error and leaves the state unchanged.
     pub fn track(&mut self, frames: &[FrameView<'_>]) -> Result<FrameReport, TrackerError> {
+        self.check_frames(frames)?;
+        self.track_with(&mut LocalFrames::new(frames))
+    }
+
+    /// One frame per camera, each of its camera's size.
+    fn check_frames(&self, frames: &[FrameView<'_>]) -> Result<(), TrackerError> {
         if frames.len() != self.cameras.len() {
             return Err(TrackerError::FrameCount);
         }
@@ -416,7 +435,48 @@ impl Tracker {
                 }));
             }
         }
-        self.track_with(&mut LocalFrames::new(frames))
+        Ok(())
+    }
+
+    /// After a frame tracked and not lost: every [`ShadingRefineConfig::every_frames`] calls,
+    /// one finger in turn is moved where the hand's shading in `frames` says it lies
+    /// ([`crate::likelihood::shading_refine`]). The velocity is kept, so the next prediction
+    /// goes on from the finger as moved. Off by default (`every_frames` 0: nothing happens,
+    /// and nothing is counted). A frame of the wrong size is an error and moves nothing.
+    pub fn refine_shading(
+        &mut self,
+        frames: &[FrameView<'_>],
+    ) -> Result<RefineOutcome, TrackerError> {
+        let config = self.config.shading_refine;
+        let count = self.fingers.count() as u32;
+        if config.every_frames == 0 || count == 0 {
+            return Ok(RefineOutcome::default());
+        }
+        self.check_frames(frames)?;
+        self.shading_calls = self.shading_calls.wrapping_add(1);
+        let every = u32::from(config.every_frames);
+        if !self.shading_calls.is_multiple_of(every) {
+            return Ok(RefineOutcome::default());
+        }
+        let finger = ((self.shading_calls / every) % count) as usize;
+        let mut q = self.state.clone();
+        // The last iteration's first view is spent: the next frame projects afresh.
+        let work = &mut self.work;
+        let outcome = refine_finger(
+            &self.model,
+            &self.cameras,
+            frames,
+            &self.fingers,
+            finger,
+            &mut q,
+            &mut work.poses,
+            &mut work.views[0],
+            &config,
+        );
+        if outcome.moves > 0 {
+            self.state = q;
+        }
+        Ok(outcome)
     }
 
     /// Tracks one instant with features from `measurer` (one camera per entry of

@@ -39,12 +39,13 @@ use digiteyes_core::hypotheses::fingers::Fingers;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::shading;
 use digiteyes_core::model::Shape;
-use digiteyes_core::projection::ProjectedModel;
+use digiteyes_core::projection::{Bounds, ProjectedModel};
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::eval::{compare, track_life};
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::sequence_tracker;
 use digiteyes_host::TrackerConfig;
+use nalgebra::Vector2;
 
 #[derive(Parser)]
 struct Args {
@@ -79,6 +80,9 @@ struct Args {
     /// Re-search every finger at each re-search frame instead of one in turn.
     #[arg(long)]
     all_fingers: bool,
+    /// The pixel step of `--choose local`'s residual.
+    #[arg(long, default_value_t = 2.0)]
+    local_step_px: f32,
     /// The change `--choose nudge` makes to each of the finger's joints (rad).
     #[arg(long, default_value_t = 1e-3)]
     nudge_rad: f32,
@@ -101,6 +105,13 @@ enum Choose {
     /// residual (each joint ±0.08, ±0.04, ±0.02 rad in turn, a move kept when it leaves less):
     /// does the shading pull a finger back where the edges do not?
     Polish,
+    /// `polish`, but each move judged only where the finger is: the tracked state's fit
+    /// kept (not fitted again), its residual summed over every `--local-step-px`-th pixel of
+    /// the finger's links' image bounds widened by 20 px (`shading::residual_in`).
+    Local,
+    /// `local` as the core runs it: `Tracker::refine_shading` after every frame
+    /// (`TrackerConfig::shading_refine`, every `--every` frames, margin `--margin`).
+    Core,
 }
 
 /// The three levels of a joint's range the re-search starts from.
@@ -119,6 +130,81 @@ fn shading_residual(sequence: &Sequence, frames: &[FrameView<'_>], q: &[f32], gr
         sum += shading::fit(&view, camera, frame, grid).map_or(f64::INFINITY, |f| {
             f64::from(f.rms).powi(2) * f64::from(f.points)
         });
+    }
+    sum
+}
+
+/// Per camera, the shading fitted at `state` and the image bounds of the links that the joint
+/// states `joints` move (of one finger) at `state`, widened by 20 px; `None` for a camera with
+/// no fit.
+fn local_fits(
+    sequence: &Sequence,
+    frames: &[FrameView<'_>],
+    state: &[f32],
+    joints: &[usize],
+    grid: usize,
+) -> Vec<Option<([f32; 5], Bounds)>> {
+    let model = &sequence.model;
+    let frames_of_finger: Vec<usize> = joints
+        .iter()
+        .filter_map(|&s| model.joint_frame(s))
+        .collect();
+    let Ok(poses) = Poses::compute(model, state) else {
+        return vec![None; sequence.cameras.len()];
+    };
+    let mut view = ProjectedModel::new();
+    sequence
+        .cameras
+        .iter()
+        .zip(frames)
+        .map(|(camera, frame)| {
+            view.update(model, &poses, camera, 0.0);
+            let fit = shading::fit(&view, camera, frame, grid)?;
+            let bounds = view
+                .links
+                .iter()
+                .filter(|l| {
+                    frames_of_finger.contains(&usize::from(l.frame))
+                        || frames_of_finger.contains(&usize::from(l.child))
+                })
+                .map(|l| l.bounds)
+                .reduce(|a, b| Bounds {
+                    min: a.min.inf(&b.min),
+                    max: a.max.sup(&b.max),
+                })?;
+            let pad = Vector2::new(20.0, 20.0);
+            Some((
+                fit.terms,
+                Bounds {
+                    min: bounds.min - pad,
+                    max: bounds.max + pad,
+                },
+            ))
+        })
+        .collect()
+}
+
+/// The summed squared residual of `q`'s normals against each camera's fit kept from
+/// [`local_fits`], over its region (infinite where a camera has none).
+fn local_residual(
+    sequence: &Sequence,
+    frames: &[FrameView<'_>],
+    q: &[f32],
+    fits: &[Option<([f32; 5], Bounds)>],
+    step_px: f32,
+) -> f64 {
+    let Ok(poses) = Poses::compute(&sequence.model, q) else {
+        return f64::INFINITY;
+    };
+    let mut view = ProjectedModel::new();
+    let mut sum = 0.0;
+    for ((camera, frame), fit) in sequence.cameras.iter().zip(frames).zip(fits) {
+        let Some((terms, region)) = fit else {
+            return f64::INFINITY;
+        };
+        view.update(&sequence.model, &poses, camera, 0.0);
+        sum += shading::residual_in(&view, camera, frame, terms, region, step_px)
+            .map_or(f64::INFINITY, |r| f64::from(r.sum_sq));
     }
     sum
 }
@@ -168,9 +254,17 @@ fn research(
         ),
         _ => None,
     };
-    if matches!(args.choose, Choose::Polish) {
+    if matches!(args.choose, Choose::Polish | Choose::Local) {
+        let local = match args.choose {
+            Choose::Local => Some(local_fits(sequence, frames, &state, &joints, args.grid)),
+            _ => None,
+        };
+        let residual_of = |q: &[f32]| match &local {
+            Some(fits) => local_residual(sequence, frames, q, fits, args.local_step_px),
+            None => shading_residual(sequence, frames, q, args.grid),
+        };
         let mut q = state.clone();
-        let mut best = shading_residual(sequence, frames, &q, args.grid);
+        let mut best = residual_of(&q);
         for step in [0.08f32, 0.04, 0.02] {
             for &s in &joints {
                 let Some(limit) = sequence.model.limit(s) else {
@@ -179,7 +273,7 @@ fn research(
                 for sign in [1.0f32, -1.0] {
                     let mut trial = q.clone();
                     trial[s] = (q[s] + sign * step).clamp(limit.lo, limit.hi);
-                    let residual = shading_residual(sequence, frames, &trial, args.grid);
+                    let residual = residual_of(&trial);
                     if residual < best * (1.0 - args.margin) {
                         (best, q) = (residual, trial);
                         break;
@@ -227,7 +321,7 @@ fn research(
             truth,
         )),
         Choose::Joints => joint_rms_rad(q, truth),
-        Choose::Truth | Choose::Nudge | Choose::Polish => 0.0,
+        Choose::Truth | Choose::Nudge | Choose::Polish | Choose::Local | Choose::Core => 0.0,
     };
     let mut best = (score(&state) * (1.0 - args.margin), state.clone());
     let mut switched = false;
@@ -273,7 +367,14 @@ fn run(
     every: usize,
 ) -> Result<(Vec<f64>, usize)> {
     let fingers = Fingers::of(&sequence.model);
-    let mut tracker = sequence_tracker(sequence, TrackerConfig::default())?;
+    let mut config = TrackerConfig::default();
+    if matches!(args.choose, Choose::Core) && every > 0 {
+        config.shading_refine.every_frames = every as u8;
+        config.shading_refine.margin = args.margin as f32;
+        config.shading_refine.region_step_px = args.local_step_px;
+        config.shading_refine.grid = args.grid as u8;
+    }
+    let mut tracker = sequence_tracker(sequence, config)?;
     let mut memory = tracker.memory();
     memory.state = heapless::Vec::from_slice(&truth[0]).map_err(|_| anyhow::anyhow!("states"))?;
     memory.velocity = None;
@@ -284,7 +385,9 @@ fn run(
         let images = kept::read_instant(sequence, k)?;
         let frames = kept::views(&images)?;
         tracker.track(&frames)?;
-        if every > 0 && k % every == 0 {
+        if matches!(args.choose, Choose::Core) {
+            switched += usize::from(tracker.refine_shading(&frames)?.moves > 0);
+        } else if every > 0 && k % every == 0 {
             let turn = (k / every) % fingers.count().max(1);
             let chosen = if args.all_fingers {
                 0..fingers.count()

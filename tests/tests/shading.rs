@@ -6,8 +6,10 @@
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::fingers::Fingers;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::likelihood::shading::{fit, ShadingFit};
-use digiteyes_core::projection::ProjectedModel;
+use digiteyes_core::likelihood::shading::{fit, residual_in, ShadingFit};
+use digiteyes_core::nalgebra::Vector2;
+use digiteyes_core::projection::{Bounds, ProjectedModel};
+use digiteyes_core::silhouette::hand_bounds;
 use digiteyes_host::scenarios::{generate, RenderOptions};
 use digiteyes_host::sequence::Sequence;
 
@@ -24,16 +26,35 @@ fn view_of(sequence: &Sequence, q: &[f32]) -> ProjectedModel {
     view
 }
 
-/// The fit of `view` to camera 0's frame `k`.
-fn fit_view(sequence: &Sequence, k: usize, view: &ProjectedModel) -> Option<ShadingFit> {
-    let image = sequence.read_frame(0, k).unwrap();
-    let frame = FrameView::packed(
+/// Camera 0's frame `k`.
+fn image_of(sequence: &Sequence, k: usize) -> image::GrayImage {
+    sequence.read_frame(0, k).unwrap()
+}
+
+/// A view of `image`.
+fn frame_of(image: &image::GrayImage) -> FrameView<'_> {
+    FrameView::packed(
         image.as_raw(),
         image.width() as usize,
         image.height() as usize,
     )
-    .unwrap();
-    fit(view, &sequence.cameras[0], &frame, GRID)
+    .unwrap()
+}
+
+/// The fit of `view` to camera 0's frame `k`.
+fn fit_view(sequence: &Sequence, k: usize, view: &ProjectedModel) -> Option<ShadingFit> {
+    let image = image_of(sequence, k);
+    fit(view, &sequence.cameras[0], &frame_of(&image), GRID)
+}
+
+/// `q` with finger `f`'s flexions (all its states but the first) bent `rad` further.
+fn bent(q: &[f32], fingers: &Fingers, f: usize, rad: f32) -> Vec<f32> {
+    let mut out = q.to_vec();
+    let states: Vec<usize> = (0..q.len()).filter(|&s| fingers.contains(f, s)).collect();
+    for &s in states.iter().skip(1) {
+        out[s] += rad;
+    }
+    out
 }
 
 /// The fit of state `q` to camera 0's frame `k`.
@@ -62,13 +83,8 @@ fn the_true_state_leaves_less_than_a_finger_bent_off() {
                 at_truth.rms
             );
             for f in 0..fingers.count() {
-                // The finger's flexions (all but its first state) bent 0.5 rad further.
-                let mut bent = q.clone();
-                let states: Vec<usize> = (0..q.len()).filter(|&s| fingers.contains(f, s)).collect();
-                for &s in states.iter().skip(1) {
-                    bent[s] += 0.5;
-                }
-                let off = fit_at(&sequence, k, &bent).expect("a fit of the bent finger");
+                let off = fit_at(&sequence, k, &bent(&q, &fingers, f, 0.5))
+                    .expect("a fit of the bent finger");
                 cases += 1;
                 if off.rms > at_truth.rms {
                     truth_better += 1;
@@ -160,4 +176,84 @@ fn the_palm_face_a_ray_enters_by_faces_the_camera_at_the_palms_depth() {
         }
     }
     assert!(hits > 1000, "{hits} pixels on the palm");
+}
+
+#[test]
+fn the_truths_fit_kept_leaves_less_over_the_hand_than_a_finger_bent_off() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut cases, mut truth_better) = (0, 0);
+    for seed in seeds() {
+        let sequence = common::seeded(dir.path(), "random-mono", seed, 20);
+        let fingers = Fingers::of(&sequence.model);
+        let truth = sequence.read_truth().unwrap();
+        let camera = &sequence.cameras[0];
+        for k in [0, 10, 19] {
+            let q: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
+            let image = image_of(&sequence, k);
+            let frame = frame_of(&image);
+            let view = view_of(&sequence, &q);
+            let terms = fit(&view, camera, &frame, GRID).expect("a fit").terms;
+            let hand = hand_bounds(&view).expect("the hand in view");
+            let at_truth = residual_in(&view, camera, &frame, &terms, &hand, 2.0).unwrap();
+            for f in 0..fingers.count() {
+                let off_view = view_of(&sequence, &bent(&q, &fingers, f, 0.5));
+                let off = residual_in(&off_view, camera, &frame, &terms, &hand, 2.0).unwrap();
+                assert_eq!(off.points, at_truth.points, "the same pixels for both");
+                cases += 1;
+                truth_better += usize::from(off.sum_sq > at_truth.sum_sq);
+            }
+        }
+    }
+    println!("{cases} fingers bent: the truth leaves less in {truth_better}");
+    assert!(
+        truth_better * 10 >= cases * 9,
+        "the truth leaves less in only {truth_better} of {cases}"
+    );
+}
+
+#[test]
+fn a_region_with_no_hand_leaves_the_background_terms_residual_and_none_outside_the_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let sequence = common::seeded(dir.path(), "random-mono", 203, 1);
+    let image = image_of(&sequence, 0);
+    let frame = frame_of(&image);
+    let camera = &sequence.cameras[0];
+    let empty = ProjectedModel::new();
+    let terms = [90.0, 150.0, 10.0, -20.0, 30.0];
+    let region = Bounds {
+        min: Vector2::new(10.5, 20.0),
+        max: Vector2::new(50.0, 41.0),
+    };
+    let found = residual_in(&empty, camera, &frame, &terms, &region, 3.0).unwrap();
+    let (mut sum_sq, mut points) = (0.0f64, 0u32);
+    for j in 0..=7 {
+        for i in 0..=13 {
+            let g = frame
+                .sample(10.5 + 3.0 * i as f32, 20.0 + 3.0 * j as f32)
+                .unwrap();
+            sum_sq += f64::from(terms[0] - g).powi(2);
+            points += 1;
+        }
+    }
+    assert_eq!(found.points, points);
+    assert!(
+        (f64::from(found.sum_sq) - sum_sq).abs() <= 1e-4 * sum_sq,
+        "{} against {sum_sq}",
+        found.sum_sq
+    );
+    let outside = Bounds {
+        min: Vector2::new(400.0, 10.0),
+        max: Vector2::new(500.0, 20.0),
+    };
+    assert_eq!(
+        residual_in(&empty, camera, &frame, &terms, &outside, 1.0),
+        None
+    );
+    // A step that is not a number is taken as one pixel.
+    let one_px = Bounds {
+        min: Vector2::new(10.0, 10.0),
+        max: Vector2::new(12.0, 11.0),
+    };
+    let r = residual_in(&empty, camera, &frame, &terms, &one_px, f32::NAN).unwrap();
+    assert_eq!(r.points, 6);
 }

@@ -35,6 +35,7 @@ use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_CANDIDATES, MAX_HYPOTHESES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
+use crate::likelihood::shading_refine::RefineOutcome;
 use crate::likelihood::{BuiltEdges, EdgeMap, Reads, Scene};
 use crate::state::{clamp_to_limit, renormalise_quaternion};
 use crate::tracker::{FrameReport, TrackMemory, Tracker, TrackerError};
@@ -143,6 +144,21 @@ impl MultiTracker {
     /// carried are the ones from before.
     pub fn tracker_mut(&mut self) -> &mut Tracker {
         &mut self.tracker
+    }
+
+    /// [`Tracker::refine_shading`] on the best hypothesis (the tracker's), which then carries
+    /// the state as moved.
+    pub fn refine_shading(
+        &mut self,
+        frames: &[FrameView<'_>],
+    ) -> Result<RefineOutcome, TrackerError> {
+        let outcome = self.tracker.refine_shading(frames)?;
+        if outcome.moves > 0 {
+            if let Some(best) = self.hypotheses.first_mut() {
+                best.memory = self.tracker.memory();
+            }
+        }
+        Ok(outcome)
     }
 
     /// Forgets every hypothesis but the tracker's present memory, which becomes the only one.

@@ -20,7 +20,7 @@ use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use crate::camera::Camera;
 use crate::config::MAX_LINKS;
 use crate::frame::FrameView;
-use crate::projection::ProjectedModel;
+use crate::projection::{Bounds, ProjectedModel};
 use crate::silhouette::hand_bounds;
 
 /// The largest lattice side [`fit`] takes.
@@ -49,7 +49,7 @@ pub struct ShadingFit {
 
 /// The nearest surface of `view` on the ray through pixel `p`: its outward unit normal in
 /// camera coordinates; `None` off the hand. `ends` holds each link's axis ends in camera
-/// coordinates (mm), as [`fit`] computes them.
+/// coordinates (mm), as [`axis_ends`] computes them.
 fn normal_at(
     view: &ProjectedModel,
     camera: &Camera,
@@ -77,6 +77,24 @@ fn normal_at(
         }
     }
     best.map(|(_, n)| n)
+}
+
+/// A lattice point's row of the fit: background where no surface is hit, else the hand's grey
+/// and the light's three components times the normal.
+fn row_of(normal: Option<Vector3<f32>>) -> SVector<f32, TERMS> {
+    match normal {
+        Some(n) => SVector::<f32, TERMS>::new(0.0, 1.0, n.x, n.y, n.z),
+        None => SVector::<f32, TERMS>::new(1.0, 0.0, 0.0, 0.0, 0.0),
+    }
+}
+
+/// The link axis ends of `view` in camera coordinates (mm), as [`normal_at`] takes them.
+fn axis_ends(view: &ProjectedModel, camera: &Camera) -> [(Vector3<f32>, Vector3<f32>); MAX_LINKS] {
+    let mut ends = [(Vector3::zeros(), Vector3::zeros()); MAX_LINKS];
+    for (end, link) in ends.iter_mut().zip(&view.links) {
+        *end = (camera.to_camera(&link.p0), camera.to_camera(&link.p1));
+    }
+    ends
 }
 
 /// The nearest intersection of the ray `t · d` (t > 0, `d` unit, from the camera centre) with
@@ -147,20 +165,13 @@ pub fn fit(
     if !(step.x.is_finite() && step.y.is_finite()) {
         return None;
     }
-    let mut ends = [(Vector3::zeros(), Vector3::zeros()); MAX_LINKS];
-    for (end, link) in ends.iter_mut().zip(&view.links) {
-        *end = (camera.to_camera(&link.p0), camera.to_camera(&link.p1));
-    }
+    let ends = axis_ends(view, camera);
     let ends = &ends[..view.links.len().min(MAX_LINKS)];
     // Each lattice point in the frame: its row of the fit and its grey level.
     let row_at = |i: usize, j: usize| {
         let p = Vector2::new(min.x + step.x * i as f32, min.y + step.y * j as f32);
         let g = frame.sample(p.x, p.y)?;
-        let row = match normal_at(view, camera, ends, &p) {
-            Some(n) => SVector::<f32, TERMS>::new(0.0, 1.0, n.x, n.y, n.z),
-            None => SVector::<f32, TERMS>::new(1.0, 0.0, 0.0, 0.0, 0.0),
-        };
-        Some((row, g))
+        Some((row_of(normal_at(view, camera, ends, &p)), g))
     };
     let mut normal = SMatrix::<f32, TERMS, TERMS>::zeros();
     let mut rhs = SVector::<f32, TERMS>::zeros();
@@ -201,4 +212,59 @@ pub fn fit(
         on_hand,
         terms: [terms[0], terms[1], terms[2], terms[3], terms[4]],
     })
+}
+
+/// The squared residual of a shading already fitted ([`ShadingFit::terms`]) over a region of
+/// the image: what a change confined there (one finger moved) does to the fit, without
+/// fitting again.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RegionResidual {
+    /// Sum of squared residuals (grey levels²).
+    pub sum_sq: f32,
+    /// Pixels sampled (inside the frame).
+    pub points: u32,
+}
+
+/// The residual of `terms` (as [`fit`] found them, for this camera and frame) against the
+/// normals of `view` at every `step_px`-th pixel of `region` (px, clipped to the frame; the
+/// step at least 1 px). `None` when no pixel of the region lies in the frame, or the sum is
+/// not finite.
+pub fn residual_in(
+    view: &ProjectedModel,
+    camera: &Camera,
+    frame: &FrameView<'_>,
+    terms: &[f32; TERMS],
+    region: &Bounds,
+    step_px: f32,
+) -> Option<RegionResidual> {
+    let step = if step_px.is_finite() {
+        step_px.max(1.0)
+    } else {
+        1.0
+    };
+    let last = Vector2::new(frame.width() as f32 - 1.0, frame.height() as f32 - 1.0);
+    let min = Vector2::new(region.min.x.max(0.0), region.min.y.max(0.0));
+    let max = Vector2::new(region.max.x.min(last.x), region.max.y.min(last.y));
+    if !(min.x <= max.x && min.y <= max.y) {
+        return None;
+    }
+    let columns = libm::floorf((max.x - min.x) / step) as u32 + 1;
+    let rows = libm::floorf((max.y - min.y) / step) as u32 + 1;
+    let ends = axis_ends(view, camera);
+    let ends = &ends[..view.links.len().min(MAX_LINKS)];
+    let terms = SVector::<f32, TERMS>::from_column_slice(terms);
+    let (mut sum_sq, mut points) = (0.0f32, 0u32);
+    for j in 0..rows {
+        for i in 0..columns {
+            let p = Vector2::new(min.x + step * i as f32, min.y + step * j as f32);
+            let Some(g) = frame.sample(p.x, p.y) else {
+                continue;
+            };
+            let e = row_of(normal_at(view, camera, ends, &p)).dot(&terms) - g;
+            sum_sq += e * e;
+            points += 1;
+        }
+    }
+    (points > 0 && sum_sq.is_finite()).then_some(RegionResidual { sum_sq, points })
 }

@@ -63,6 +63,11 @@ pub struct TrackArgs {
     /// Start each frame from the last estimate instead of a constant-velocity prediction.
     #[arg(long)]
     pub no_predict: bool,
+    /// After every N-th frame tracked, move one finger in turn where the hand's shading
+    /// says it lies (0: never, the default). Costs up to 30 residuals over a finger a frame;
+    /// docs/robustness.md, "The shading pulls a finger back".
+    #[arg(long, value_name = "N")]
+    pub shading_refine: Option<u8>,
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
@@ -120,7 +125,10 @@ pub fn run(args: TrackArgs, progress: bool) -> Result<()> {
         Some(args.score_every),
         &args.hypothesis_budget,
     )?;
-    let config = tracker_config(args.iterations, args.no_predict);
+    let mut config = tracker_config(args.iterations, args.no_predict);
+    if let Some(every) = args.shading_refine {
+        config.shading_refine.every_frames = every;
+    }
     let options = TrackOptions {
         init: args.init.map(|i| match i {
             InitArg::Given => Init::Given,

@@ -1,0 +1,194 @@
+//! One finger's joints moved where the hand's shading says it lies: a pattern search on the
+//! residual of the shading fit ([`super::shading`]), judged only around the finger.
+//!
+//! The shading is fitted once at the given state (one light, hand grey and background per
+//! camera); each trial moves one of the finger's joint states by ± a step (clamped to its
+//! range) and is scored by the residual of that same fit over the finger's image region (its
+//! links' bounds at the start, widened), summed over the cameras. A trial that leaves less
+//! than `1 − margin` of the best so far is kept at once; the steps shrink from the first to
+//! the last of [`ShadingRefineConfig::steps_rad`]. The slice search's edges cannot pull back a
+//! finger a few pixels off (they are found around the wrong state too); its shading can.
+//!
+//! Measured on the plain tracker (`host/examples/finger_research.rs`, `docs/robustness.md`,
+//! "How often a finger must be put right"): one finger in turn after each frame.
+
+use heapless::Vec;
+use nalgebra::Vector2;
+
+use super::shading::{fit, residual_in};
+use crate::camera::Camera;
+use crate::config::{MAX_CAMERAS, MAX_STATES};
+use crate::frame::FrameView;
+use crate::hypotheses::fingers::Fingers;
+use crate::kinematics::Poses;
+use crate::model::Model;
+use crate::projection::{Bounds, ProjectedModel};
+
+/// Most joint states of one finger the search moves.
+pub const MAX_FINGER_JOINTS: usize = 8;
+
+/// The search's parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ShadingRefineConfig {
+    /// Refine one finger (in turn) after every this many frames tracked (0: never, the
+    /// default; the tracker as before, bit for bit).
+    pub every_frames: u8,
+    /// The shading fit's lattice side (2..=[`super::shading::MAX_SHADING_GRID`]).
+    pub grid: u8,
+    /// The residual's pixel step over the finger's region (px, at least 1).
+    pub region_step_px: f32,
+    /// How far the finger's region reaches beyond its links' bounds (px).
+    pub region_pad_px: f32,
+    /// The steps tried on each joint, in order (rad; 0 skips one).
+    pub steps_rad: [f32; 3],
+    /// A trial is kept when it leaves less than `1 − margin` of the best residual so far.
+    pub margin: f32,
+}
+
+impl Default for ShadingRefineConfig {
+    fn default() -> Self {
+        ShadingRefineConfig {
+            every_frames: 0,
+            grid: 64,
+            region_step_px: 2.0,
+            region_pad_px: 20.0,
+            steps_rad: [0.08, 0.04, 0.02],
+            margin: 0.0,
+        }
+    }
+}
+
+/// What one refinement did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RefineOutcome {
+    /// Trials kept.
+    pub moves: u8,
+    /// Trials scored.
+    pub trials: u8,
+}
+
+/// Per camera: the shading fitted at the start and the finger's region, `None` when that
+/// camera gives no fit or sees none of the finger's links.
+type Fits = [Option<([f32; 5], Bounds)>; MAX_CAMERAS];
+
+/// Refines finger `finger` of `state` (one value per model state) on `frames` (one per
+/// camera), in place. `poses` and `view` are working memory. Nothing moves when the state
+/// cannot be posed, a camera gives no fit or sees none of the finger, or no trial leaves less.
+#[allow(clippy::too_many_arguments)] // the tracker's parts, lent for one call
+pub fn refine_finger(
+    model: &Model,
+    cameras: &[Camera],
+    frames: &[FrameView<'_>],
+    fingers: &Fingers,
+    finger: usize,
+    state: &mut [f32],
+    poses: &mut Poses,
+    view: &mut ProjectedModel,
+    config: &ShadingRefineConfig,
+) -> RefineOutcome {
+    let mut outcome = RefineOutcome::default();
+    let n = state.len().min(MAX_STATES);
+    let joints: Vec<usize, MAX_FINGER_JOINTS> = (0..n)
+        .filter(|&s| fingers.contains(finger, s))
+        .take(MAX_FINGER_JOINTS)
+        .collect();
+    let Some(fits) = start_fits(model, cameras, frames, &joints, state, poses, view, config) else {
+        return outcome;
+    };
+    let score = |q: &[f32], poses: &mut Poses, view: &mut ProjectedModel| {
+        if poses.update(model, q).is_err() {
+            return f32::INFINITY;
+        }
+        let mut sum = 0.0f32;
+        for ((camera, frame), fit) in cameras.iter().zip(frames).zip(&fits) {
+            let Some((terms, region)) = fit else {
+                return f32::INFINITY;
+            };
+            view.update(model, poses, camera, 0.0);
+            match residual_in(view, camera, frame, terms, region, config.region_step_px) {
+                Some(r) => sum += r.sum_sq,
+                None => return f32::INFINITY,
+            }
+        }
+        sum
+    };
+    let mut best = score(&state[..n], poses, view);
+    if !best.is_finite() {
+        return outcome;
+    }
+    let mut trial = [0.0f32; MAX_STATES];
+    for &step in &config.steps_rad {
+        if !(step.is_finite() && step > 0.0) {
+            continue;
+        }
+        for &s in &joints {
+            let Some(limit) = model.limit(s) else {
+                continue;
+            };
+            for sign in [1.0f32, -1.0] {
+                trial[..n].copy_from_slice(&state[..n]);
+                trial[s] = (state[s] + sign * step).clamp(limit.lo, limit.hi);
+                if trial[s] == state[s] {
+                    continue;
+                }
+                outcome.trials = outcome.trials.saturating_add(1);
+                let residual = score(&trial[..n], poses, view);
+                if residual < best * (1.0 - config.margin) {
+                    best = residual;
+                    state[s] = trial[s];
+                    outcome.moves = outcome.moves.saturating_add(1);
+                    break;
+                }
+            }
+        }
+    }
+    // The caller's poses left at the state returned.
+    let _ = poses.update(model, &state[..n]);
+    outcome
+}
+
+/// Each camera's shading fitted at `state` and the region of the links that `joints` move,
+/// widened; `None` when the state cannot be posed or some camera has neither.
+#[allow(clippy::too_many_arguments)]
+fn start_fits(
+    model: &Model,
+    cameras: &[Camera],
+    frames: &[FrameView<'_>],
+    joints: &[usize],
+    state: &[f32],
+    poses: &mut Poses,
+    view: &mut ProjectedModel,
+    config: &ShadingRefineConfig,
+) -> Option<Fits> {
+    poses.update(model, state).ok()?;
+    let moved_by_finger = |frame: u8| {
+        joints
+            .iter()
+            .any(|&s| model.joint_frame(s) == Some(usize::from(frame)))
+    };
+    let pad = Vector2::new(config.region_pad_px, config.region_pad_px);
+    let mut fits: Fits = [None; MAX_CAMERAS];
+    for ((camera, frame), slot) in cameras.iter().zip(frames).zip(fits.iter_mut()) {
+        view.update(model, poses, camera, 0.0);
+        let found = fit(view, camera, frame, usize::from(config.grid))?;
+        let bounds = view
+            .links
+            .iter()
+            .filter(|l| moved_by_finger(l.frame) || moved_by_finger(l.child))
+            .map(|l| l.bounds)
+            .reduce(|a, b| Bounds {
+                min: a.min.inf(&b.min),
+                max: a.max.sup(&b.max),
+            })?;
+        *slot = Some((
+            found.terms,
+            Bounds {
+                min: bounds.min - pad,
+                max: bounds.max + pad,
+            },
+        ));
+    }
+    Some(fits)
+}

@@ -1,0 +1,201 @@
+//! A finger moved where the hand's shading says it lies (`likelihood::shading_refine`,
+//! `Tracker::refine_shading`), on frames from our renderer and rigs nobody tuned it for
+//! (random-mono seeds 301..=315, odd): a finger bent off comes back toward the truth, a finger
+//! at the truth stays there, the tracker does nothing unless asked, and a frame of the wrong
+//! size moves nothing.
+
+use digiteyes_core::frame::FrameView;
+use digiteyes_core::hypotheses::fingers::Fingers;
+use digiteyes_core::kinematics::Poses;
+use digiteyes_core::likelihood::shading_refine::{refine_finger, ShadingRefineConfig};
+use digiteyes_core::model::{Model, Shape};
+use digiteyes_core::projection::ProjectedModel;
+use digiteyes_core::tracker::{TrackerConfig, TrackerError};
+use digiteyes_host::sequence::Sequence;
+use digiteyes_host::sequence_tracker;
+
+mod common;
+
+/// Seeds, each rendered 12 frames at 320×240.
+fn seeds() -> impl Iterator<Item = u64> {
+    (0..8).map(|i| 301 + 2 * i)
+}
+
+/// Mean fingertip distance (px) between states `a` and `b` in camera 0.
+fn tip_distance_px(sequence: &Sequence, a: &[f32], b: &[f32]) -> f32 {
+    let model: &Model = &sequence.model;
+    let (pa, pb) = (
+        Poses::compute(model, a).unwrap(),
+        Poses::compute(model, b).unwrap(),
+    );
+    let camera = &sequence.cameras[0];
+    let tips: Vec<usize> = (0..model.links().len())
+        .filter(|&i| matches!(model.links()[i].shape, Shape::Tip { .. }))
+        .collect();
+    let sum: f32 = tips
+        .iter()
+        .map(|&t| {
+            let (x, y) = (pa.origin(t).unwrap(), pb.origin(t).unwrap());
+            (camera.project(&x).unwrap() - camera.project(&y).unwrap()).norm()
+        })
+        .sum();
+    sum / tips.len() as f32
+}
+
+/// Refines finger `f` of `q` on camera 0's frame `k` with `config`, `passes` times.
+fn refined(
+    sequence: &Sequence,
+    k: usize,
+    q: &[f32],
+    f: usize,
+    passes: usize,
+    config: &ShadingRefineConfig,
+) -> Vec<f32> {
+    let image = sequence.read_frame(0, k).unwrap();
+    let frame = FrameView::packed(
+        image.as_raw(),
+        image.width() as usize,
+        image.height() as usize,
+    )
+    .unwrap();
+    let fingers = Fingers::of(&sequence.model);
+    let mut poses = Poses::compute(&sequence.model, q).unwrap();
+    let mut view = ProjectedModel::new();
+    let mut out = q.to_vec();
+    for _ in 0..passes {
+        refine_finger(
+            &sequence.model,
+            &sequence.cameras,
+            &[frame],
+            &fingers,
+            f,
+            &mut out,
+            &mut poses,
+            &mut view,
+            config,
+        );
+    }
+    out
+}
+
+/// Each seed's true state at frame `k`.
+fn truth_at(sequence: &Sequence, k: usize) -> Vec<f32> {
+    let truth = sequence.read_truth().unwrap();
+    truth.rows[k].iter().map(|&v| v as f32).collect()
+}
+
+#[test]
+fn a_finger_bent_off_comes_back_toward_the_truth() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = ShadingRefineConfig::default();
+    let (mut cases, mut nearer, mut before_sum, mut after_sum) = (0, 0, 0.0, 0.0);
+    for seed in seeds() {
+        let sequence = common::seeded(dir.path(), "random-mono", seed, 12);
+        let fingers = Fingers::of(&sequence.model);
+        for k in [0, 11] {
+            let q = truth_at(&sequence, k);
+            for f in 0..fingers.count() {
+                // The finger's flexions (all its states but the first) bent 0.12 rad further,
+                // within their ranges.
+                let mut off = q.clone();
+                let states: Vec<usize> = (0..q.len()).filter(|&s| fingers.contains(f, s)).collect();
+                for &s in states.iter().skip(1) {
+                    let limit = sequence.model.limit(s).unwrap();
+                    off[s] = (off[s] + 0.12).clamp(limit.lo, limit.hi);
+                }
+                let before = tip_distance_px(&sequence, &off, &q);
+                if before < 1.0 {
+                    continue; // a finger at its limit, or seen end-on: nothing to pull back
+                }
+                let after =
+                    tip_distance_px(&sequence, &refined(&sequence, k, &off, f, 3, &config), &q);
+                cases += 1;
+                nearer += usize::from(after < before);
+                before_sum += before;
+                after_sum += after;
+            }
+        }
+    }
+    println!(
+        "{cases} fingers: nearer the truth after in {nearer}; mean tip error {:.2} -> {:.2} px",
+        before_sum / cases as f32,
+        after_sum / cases as f32
+    );
+    assert!(cases >= 40, "{cases} cases");
+    assert!(
+        nearer * 10 >= cases * 7,
+        "nearer in only {nearer} of {cases}"
+    );
+    assert!(after_sum < 0.7 * before_sum, "{before_sum} -> {after_sum}");
+}
+
+#[test]
+fn a_finger_at_the_truth_stays_near_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = ShadingRefineConfig::default();
+    let mut moved = Vec::new();
+    for seed in seeds() {
+        let sequence = common::seeded(dir.path(), "random-mono", seed, 1);
+        let fingers = Fingers::of(&sequence.model);
+        let q = truth_at(&sequence, 0);
+        for f in 0..fingers.count() {
+            let after = refined(&sequence, 0, &q, f, 1, &config);
+            moved.push(tip_distance_px(&sequence, &after, &q));
+        }
+    }
+    moved.sort_by(f32::total_cmp);
+    let median = moved[moved.len() / 2];
+    println!(
+        "tip moved from the truth: median {median:.2} px, most {:.2}",
+        moved[moved.len() - 1]
+    );
+    assert!(median < 1.0, "{moved:?}");
+}
+
+#[test]
+fn the_tracker_refines_only_when_asked_and_refuses_a_wrong_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let sequence = common::seeded(dir.path(), "random-mono", 301, 2);
+    let image = sequence.read_frame(0, 1).unwrap();
+    let frame = FrameView::packed(
+        image.as_raw(),
+        image.width() as usize,
+        image.height() as usize,
+    )
+    .unwrap();
+    // Off by default: nothing moves, nothing is counted.
+    let mut tracker = sequence_tracker(&sequence, TrackerConfig::default()).unwrap();
+    tracker.track(&[frame]).unwrap();
+    let before = tracker.memory();
+    let outcome = tracker.refine_shading(&[frame]).unwrap();
+    assert_eq!(outcome.trials, 0);
+    assert_eq!(tracker.memory(), before);
+    // Asked, from a finger bent off: it moves, and keeps the velocity.
+    let mut config = TrackerConfig::default();
+    config.shading_refine.every_frames = 1;
+    let mut tracker = sequence_tracker(&sequence, config).unwrap();
+    tracker.track(&[frame]).unwrap();
+    let mut memory = tracker.memory();
+    let fingers = Fingers::of(&sequence.model);
+    // The first call refines finger 1.
+    for s in (0..memory.state.len())
+        .filter(|&s| fingers.contains(1, s))
+        .skip(1)
+    {
+        memory.state[s] += 0.15;
+    }
+    tracker.restore(&memory).unwrap();
+    let outcome = tracker.refine_shading(&[frame]).unwrap();
+    assert!(outcome.trials > 0 && outcome.moves > 0, "{outcome:?}");
+    assert_ne!(tracker.state(), &memory.state[..]);
+    assert_eq!(tracker.memory().velocity, memory.velocity);
+    // A frame of the wrong size: an error, and nothing moves.
+    let small = vec![0u8; 16 * 16];
+    let wrong = FrameView::packed(&small, 16, 16).unwrap();
+    let kept = tracker.memory();
+    assert!(matches!(
+        tracker.refine_shading(&[wrong]),
+        Err(TrackerError::Frame(_))
+    ));
+    assert_eq!(tracker.memory(), kept);
+}
