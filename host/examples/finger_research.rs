@@ -437,11 +437,15 @@ fn main() -> Result<()> {
             let (plain, _) = run(&sequence, &truth, &args, 0)?;
             let (with, switched) = run(&sequence, &truth, &args, args.every)?;
             let pair = (track_life(&plain), track_life(&with));
+            let mean = |e: &[f64]| e.iter().sum::<f64>() / e.len().max(1) as f64;
             println!(
-                "{}: life {:.0} % plain, {:.0} % with the re-search ({switched} switches)",
+                "{}: life {:.0} % plain, {:.0} % with the re-search ({switched} switches); \
+                 fingertips {:.2} px plain, {:.2} px with",
                 dir.display(),
                 100.0 * pair.0,
-                100.0 * pair.1
+                100.0 * pair.1,
+                mean(&plain),
+                mean(&with)
             );
             lives[usize::from(sequence.cameras.len() > 1)].push(pair);
         }
