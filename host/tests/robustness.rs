@@ -100,10 +100,17 @@ fn the_benchmark_runs_a_tiny_sweep() {
         keep: None,
         gallery: Some(dir.path().join("gallery")),
         fixed_light: false,
+        shading_refine: 1,
     };
     let sweep = run(&args).unwrap();
     assert!(sweep.failed.is_empty(), "{:?}", sweep.failed);
     assert_eq!(sweep.seeds.len(), 2);
+    // The shading refinement was asked for, and the table and the JSON say so.
+    assert!(sweep
+        .to_string()
+        .contains("refined by its shading after every frame"));
+    let json = std::fs::read_to_string(dir.path().join("sweep.json")).unwrap();
+    assert!(json.contains("\"shading_refine\": 1"), "{json}");
     // The gallery holds each camera's frame where a seed was first truly lost, and only those.
     let mut expected: Vec<String> = sweep
         .seeds
@@ -165,6 +172,7 @@ fn a_small_sweep_holds_the_hand_better_than_the_plain_loop() {
             keep: None,
             gallery: None,
             fixed_light: false,
+            shading_refine: 0,
         })
         .unwrap()
     };

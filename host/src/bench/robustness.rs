@@ -95,6 +95,19 @@ pub struct RobustnessArgs {
     /// measured under it.
     #[arg(long)]
     pub fixed_light: bool,
+    /// After every N-th frame tracked, move one finger in turn where the hand's shading says
+    /// it lies, as `track --shading-refine N` (0: never, the default).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub shading_refine: u8,
+}
+
+impl RobustnessArgs {
+    /// The tracker configuration each seed is tracked with.
+    pub fn config(&self) -> TrackerConfig {
+        let mut config = self.motion.config();
+        config.shading_refine.every_frames = self.shading_refine;
+        config
+    }
 }
 
 /// One seed's figures.
@@ -243,7 +256,7 @@ pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResu
     };
     render_scenario(name, &seq, &options).with_context(|| format!("seed {seed}"))?;
     let states = seq.join("states.csv");
-    let summary = track_sequence_with(&seq, &states, args.motion.config(), false, None)
+    let summary = track_sequence_with(&seq, &states, args.config(), false, None)
         .with_context(|| format!("seed {seed}"))?;
     let report = evaluate(&seq, &states).with_context(|| format!("seed {seed}"))?;
     let sequence = Sequence::open(&seq)?;
@@ -292,7 +305,7 @@ pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResu
                 camera,
                 &state,
                 &frame,
-                &args.motion.config().features,
+                &args.config().features,
             )?;
             let path = gallery.join(format!("seed{seed:04}-frame{k:04}-cam{c}.png"));
             drawn
@@ -339,6 +352,7 @@ pub fn run(args: &RobustnessArgs) -> Result<Sweep> {
     }
     let sweep = Sweep {
         motion: args.motion,
+        shading_refine: args.shading_refine,
         frames: args.frames,
         size: args.size,
         fixed_light: args.fixed_light,
@@ -357,6 +371,8 @@ pub fn run(args: &RobustnessArgs) -> Result<Sweep> {
 pub struct Sweep {
     /// The configuration tracked with.
     pub motion: Motion,
+    /// A finger refined by its shading every this many frames (0: never).
+    pub shading_refine: u8,
     /// Frames per seed.
     pub frames: usize,
     /// Image size (px).
@@ -459,12 +475,17 @@ impl fmt::Display for Sweep {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "robustness sweep: {} seeds x {} frames at {}x{}, tracker: {:?}",
+            "robustness sweep: {} seeds x {} frames at {}x{}, tracker: {:?}{}",
             self.seeds.len(),
             self.frames,
             self.size.0,
             self.size.1,
-            self.motion
+            self.motion,
+            match self.shading_refine {
+                0 => String::new(),
+                1 => ", a finger refined by its shading after every frame".to_string(),
+                n => format!(", a finger refined by its shading every {n} frames"),
+            }
         )?;
         writeln!(
             f,
