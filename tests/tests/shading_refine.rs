@@ -8,38 +8,22 @@ use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::fingers::Fingers;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::shading_refine::{refine_finger, ShadingRefineConfig};
-use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_core::tracker::{TrackerConfig, TrackerError};
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::sequence_tracker;
 
 mod common;
+use common::{frames, search};
 
 /// Seeds, each rendered 12 frames at 320×240.
 fn seeds() -> impl Iterator<Item = u64> {
     (0..8).map(|i| 301 + 2 * i)
 }
 
-/// Mean fingertip distance (px) between states `a` and `b` in camera 0.
+/// Mean fingertip distance (px) between states `a` and `b`.
 fn tip_distance_px(sequence: &Sequence, a: &[f32], b: &[f32]) -> f32 {
-    let model: &Model = &sequence.model;
-    let (pa, pb) = (
-        Poses::compute(model, a).unwrap(),
-        Poses::compute(model, b).unwrap(),
-    );
-    let camera = &sequence.cameras[0];
-    let tips: Vec<usize> = (0..model.links().len())
-        .filter(|&i| matches!(model.links()[i].shape, Shape::Tip { .. }))
-        .collect();
-    let sum: f32 = tips
-        .iter()
-        .map(|&t| {
-            let (x, y) = (pa.origin(t).unwrap(), pb.origin(t).unwrap());
-            (camera.project(&x).unwrap() - camera.project(&y).unwrap()).norm()
-        })
-        .sum();
-    sum / tips.len() as f32
+    search::tip_error_px(&sequence.model, &sequence.cameras, a, b)
 }
 
 /// Refines finger `f` of `q` on camera 0's frame `k` with `config`, `passes` times.
@@ -51,13 +35,8 @@ fn refined(
     passes: usize,
     config: &ShadingRefineConfig,
 ) -> Vec<f32> {
-    let image = sequence.read_frame(0, k).unwrap();
-    let frame = FrameView::packed(
-        image.as_raw(),
-        image.width() as usize,
-        image.height() as usize,
-    )
-    .unwrap();
+    let images = frames::images(sequence, k);
+    let views = frames::views(&images);
     let fingers = Fingers::of(&sequence.model);
     let mut poses = Poses::compute(&sequence.model, q).unwrap();
     let mut view = ProjectedModel::new();
@@ -66,7 +45,7 @@ fn refined(
         refine_finger(
             &sequence.model,
             &sequence.cameras,
-            &[frame],
+            &views,
             &fingers,
             f,
             &mut out,
@@ -80,8 +59,7 @@ fn refined(
 
 /// Each seed's true state at frame `k`.
 fn truth_at(sequence: &Sequence, k: usize) -> Vec<f32> {
-    let truth = sequence.read_truth().unwrap();
-    truth.rows[k].iter().map(|&v| v as f32).collect()
+    frames::truth_states(sequence).swap_remove(k)
 }
 
 #[test]
@@ -156,13 +134,8 @@ fn a_finger_at_the_truth_stays_near_it() {
 fn the_tracker_refines_only_when_asked_and_refuses_a_wrong_frame() {
     let dir = tempfile::tempdir().unwrap();
     let sequence = common::seeded(dir.path(), "random-mono", 301, 2);
-    let image = sequence.read_frame(0, 1).unwrap();
-    let frame = FrameView::packed(
-        image.as_raw(),
-        image.width() as usize,
-        image.height() as usize,
-    )
-    .unwrap();
+    let images = frames::images(&sequence, 1);
+    let frame = frames::views(&images)[0];
     // Off by default: nothing moves, nothing is counted.
     let mut tracker = sequence_tracker(&sequence, TrackerConfig::default()).unwrap();
     tracker.track(&[frame]).unwrap();
