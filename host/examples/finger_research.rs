@@ -14,9 +14,10 @@
 //! cameras), `oracle` (the least mean fingertip distance from the true state), `joints` (the
 //! least joint-angle RMS from it). Three modes make no search: `truth` sets the finger's
 //! joints to the truth, `nudge` moves them `--nudge-rad` (the sweep's own noise), `polish`
-//! runs a pattern search on the shading residual from the tracked state. `--trigger-px` re-
-//! searches a finger only where its true joints would move its tip that far (an oracle
-//! trigger, to tell a chooser's errors from a trigger's).
+//! runs a pattern search on the shading residual from the tracked state, `core` the core's
+//! `Tracker::refine_shading`. `--trigger-px` re-searches a finger only where its true joints
+//! would move its tip that far (an oracle trigger, to tell a chooser's errors from a
+//! trigger's).
 //!
 //! Printed: each seed's track life both ways (mean fingertip error over 10 px for 5 frames,
 //! as `eval`), and the paired change, mono and stereo.
@@ -24,7 +25,7 @@
 //! ```text
 //! digiteyes bench robustness --seeds 60 --keep /tmp/keep
 //! cargo run --release -p digiteyes-host --example finger_research -- /tmp/keep \
-//!     [--choose shading|oracle|joints|truth|nudge|polish] [--every 1] [--trigger-px 5]
+//!     [--choose shading|oracle|joints|truth|nudge|polish|core] [--every 1] [--trigger-px 5]
 //! ```
 
 use std::path::PathBuf;
@@ -39,13 +40,12 @@ use digiteyes_core::hypotheses::fingers::Fingers;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::likelihood::shading;
 use digiteyes_core::model::Shape;
-use digiteyes_core::projection::{Bounds, ProjectedModel};
+use digiteyes_core::projection::ProjectedModel;
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::eval::{compare, track_life};
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::sequence_tracker;
 use digiteyes_host::TrackerConfig;
-use nalgebra::Vector2;
 
 #[derive(Parser)]
 struct Args {
@@ -80,7 +80,7 @@ struct Args {
     /// Re-search every finger at each re-search frame instead of one in turn.
     #[arg(long)]
     all_fingers: bool,
-    /// The pixel step of `--choose local`'s residual.
+    /// The pixel step of `--choose core`'s residual.
     #[arg(long, default_value_t = 2.0)]
     local_step_px: f32,
     /// The change `--choose nudge` makes to each of the finger's joints (rad).
@@ -105,12 +105,10 @@ enum Choose {
     /// residual (each joint ±0.08, ±0.04, ±0.02 rad in turn, a move kept when it leaves less):
     /// does the shading pull a finger back where the edges do not?
     Polish,
-    /// `polish`, but each move judged only where the finger is: the tracked state's fit
-    /// kept (not fitted again), its residual summed over every `--local-step-px`-th pixel of
-    /// the finger's links' image bounds widened by 20 px (`shading::residual_in`).
-    Local,
-    /// `local` as the core runs it: `Tracker::refine_shading` after every frame
-    /// (`TrackerConfig::shading_refine`, every `--every` frames, margin `--margin`).
+    /// `polish` as the core runs it: `Tracker::refine_shading` after every `--every` frames
+    /// (`TrackerConfig::shading_refine`, margin `--margin`): each move judged only where the
+    /// finger is, the start's fit kept, over every `--local-step-px`-th pixel of the finger's
+    /// links' image bounds widened by 20 px.
     Core,
 }
 
@@ -130,81 +128,6 @@ fn shading_residual(sequence: &Sequence, frames: &[FrameView<'_>], q: &[f32], gr
         sum += shading::fit(&view, camera, frame, grid).map_or(f64::INFINITY, |f| {
             f64::from(f.rms).powi(2) * f64::from(f.points)
         });
-    }
-    sum
-}
-
-/// Per camera, the shading fitted at `state` and the image bounds of the links that the joint
-/// states `joints` move (of one finger) at `state`, widened by 20 px; `None` for a camera with
-/// no fit.
-fn local_fits(
-    sequence: &Sequence,
-    frames: &[FrameView<'_>],
-    state: &[f32],
-    joints: &[usize],
-    grid: usize,
-) -> Vec<Option<([f32; 5], Bounds)>> {
-    let model = &sequence.model;
-    let frames_of_finger: Vec<usize> = joints
-        .iter()
-        .filter_map(|&s| model.joint_frame(s))
-        .collect();
-    let Ok(poses) = Poses::compute(model, state) else {
-        return vec![None; sequence.cameras.len()];
-    };
-    let mut view = ProjectedModel::new();
-    sequence
-        .cameras
-        .iter()
-        .zip(frames)
-        .map(|(camera, frame)| {
-            view.update(model, &poses, camera, 0.0);
-            let fit = shading::fit(&view, camera, frame, grid)?;
-            let bounds = view
-                .links
-                .iter()
-                .filter(|l| {
-                    frames_of_finger.contains(&usize::from(l.frame))
-                        || frames_of_finger.contains(&usize::from(l.child))
-                })
-                .map(|l| l.bounds)
-                .reduce(|a, b| Bounds {
-                    min: a.min.inf(&b.min),
-                    max: a.max.sup(&b.max),
-                })?;
-            let pad = Vector2::new(20.0, 20.0);
-            Some((
-                fit.terms,
-                Bounds {
-                    min: bounds.min - pad,
-                    max: bounds.max + pad,
-                },
-            ))
-        })
-        .collect()
-}
-
-/// The summed squared residual of `q`'s normals against each camera's fit kept from
-/// [`local_fits`], over its region (infinite where a camera has none).
-fn local_residual(
-    sequence: &Sequence,
-    frames: &[FrameView<'_>],
-    q: &[f32],
-    fits: &[Option<([f32; 5], Bounds)>],
-    step_px: f32,
-) -> f64 {
-    let Ok(poses) = Poses::compute(&sequence.model, q) else {
-        return f64::INFINITY;
-    };
-    let mut view = ProjectedModel::new();
-    let mut sum = 0.0;
-    for ((camera, frame), fit) in sequence.cameras.iter().zip(frames).zip(fits) {
-        let Some((terms, region)) = fit else {
-            return f64::INFINITY;
-        };
-        view.update(&sequence.model, &poses, camera, 0.0);
-        sum += shading::residual_in(&view, camera, frame, terms, region, step_px)
-            .map_or(f64::INFINITY, |r| f64::from(r.sum_sq));
     }
     sum
 }
@@ -254,15 +177,8 @@ fn research(
         ),
         _ => None,
     };
-    if matches!(args.choose, Choose::Polish | Choose::Local) {
-        let local = match args.choose {
-            Choose::Local => Some(local_fits(sequence, frames, &state, &joints, args.grid)),
-            _ => None,
-        };
-        let residual_of = |q: &[f32]| match &local {
-            Some(fits) => local_residual(sequence, frames, q, fits, args.local_step_px),
-            None => shading_residual(sequence, frames, q, args.grid),
-        };
+    if matches!(args.choose, Choose::Polish) {
+        let residual_of = |q: &[f32]| shading_residual(sequence, frames, q, args.grid);
         let mut q = state.clone();
         let mut best = residual_of(&q);
         for step in [0.08f32, 0.04, 0.02] {
@@ -321,7 +237,7 @@ fn research(
             truth,
         )),
         Choose::Joints => joint_rms_rad(q, truth),
-        Choose::Truth | Choose::Nudge | Choose::Polish | Choose::Local | Choose::Core => 0.0,
+        Choose::Truth | Choose::Nudge | Choose::Polish | Choose::Core => 0.0,
     };
     let mut best = (score(&state) * (1.0 - args.margin), state.clone());
     let mut switched = false;
