@@ -21,6 +21,7 @@ use crate::fill::{FillConfig, FillPoints};
 use crate::frame::{FrameError, FrameView};
 use crate::hypotheses::fingers::Fingers;
 use crate::kinematics::{KinematicsError, Poses};
+use crate::likelihood::shading_cache::ShadingCache;
 use crate::likelihood::shading_refine::{refine_finger, RefineOutcome, ShadingRefineConfig};
 use crate::measurer::{LocalFrames, Measurer};
 use crate::model::Model;
@@ -195,6 +196,8 @@ struct Workspace {
     normal: NormalEquations,
     /// Each camera's region samples, gathered on a frame's first iteration.
     fill: [FillPoints; MAX_CAMERAS],
+    /// The fixed surfaces around the finger [`Tracker::refine_shading`] searches.
+    shading: ShadingCache,
 }
 
 /// What a [`Tracker`] knows of one hand between frames: the state, the motion the next
@@ -267,6 +270,7 @@ impl Tracker {
                 jacobian: LinkJacobian::default(),
                 normal: NormalEquations::new(),
                 fill: Default::default(),
+                shading: ShadingCache::default(),
             },
         };
         tracker.reset(initial)?;
@@ -471,6 +475,7 @@ impl Tracker {
             &mut q,
             &mut work.poses,
             &mut work.views[0],
+            &mut work.shading,
             &config,
         );
         if outcome.moves > 0 {

@@ -7,6 +7,7 @@
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::fingers::Fingers;
 use digiteyes_core::kinematics::Poses;
+use digiteyes_core::likelihood::shading_cache::ShadingCache;
 use digiteyes_core::likelihood::shading_refine::{refine_finger, ShadingRefineConfig};
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_core::tracker::{TrackerConfig, TrackerError};
@@ -40,6 +41,7 @@ fn refined(
     let fingers = Fingers::of(&sequence.model);
     let mut poses = Poses::compute(&sequence.model, q).unwrap();
     let mut view = ProjectedModel::new();
+    let mut cache = ShadingCache::default();
     let mut out = q.to_vec();
     for _ in 0..passes {
         refine_finger(
@@ -51,6 +53,7 @@ fn refined(
             &mut out,
             &mut poses,
             &mut view,
+            &mut cache,
             config,
         );
     }

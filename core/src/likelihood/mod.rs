@@ -22,6 +22,7 @@ mod reverse;
 mod samples;
 mod scene;
 pub mod shading;
+pub mod shading_cache;
 pub mod shading_refine;
 mod state;
 

@@ -20,7 +20,7 @@ use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use crate::camera::Camera;
 use crate::config::MAX_LINKS;
 use crate::frame::FrameView;
-use crate::projection::{Bounds, ProjectedModel};
+use crate::projection::{Bounds, ProjectedLink, ProjectedModel};
 use crate::silhouette::hand_bounds;
 
 /// The largest lattice side [`fit`] takes.
@@ -30,7 +30,7 @@ pub const MAX_SHADING_GRID: usize = 64;
 pub const MIN_SHADING_POINTS: u16 = 8;
 
 /// The terms of the fit: background, hand, and the light's three components.
-const TERMS: usize = 5;
+pub(super) const TERMS: usize = 5;
 
 /// A state's shading fitted to one camera's frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -48,24 +48,18 @@ pub struct ShadingFit {
 }
 
 /// The nearest surface of `view` on the ray through pixel `p`: its outward unit normal in
-/// camera coordinates; `None` off the hand. `ends` holds each link's axis ends in camera
-/// coordinates (mm), as [`axis_ends`] computes them.
+/// camera coordinates; `None` off the hand. `capsules` holds each link's capsule in camera
+/// coordinates, as [`capsules`] computes them.
 fn normal_at(
     view: &ProjectedModel,
     camera: &Camera,
-    ends: &[(Vector3<f32>, Vector3<f32>)],
+    capsules: &[Capsule],
     p: &Vector2<f32>,
 ) -> Option<Vector3<f32>> {
-    let ray = camera.ray(p);
-    let length = ray.norm();
-    let d = ray / length;
+    let d = unit_ray(camera, p);
     let mut best: Option<(f32, Vector3<f32>)> = None;
-    for (link, (a, b)) in view.links.iter().zip(ends) {
-        if !link.bounds.contains(p) {
-            continue;
-        }
-        if let Some((t, n)) = ray_capsule(&d, a, b, link.radius_mm) {
-            let depth = t * d.z;
+    for (link, capsule) in view.links.iter().zip(capsules) {
+        if let Some((depth, n)) = link_hit(link, capsule, &d, p) {
             if best.is_none_or(|(z, _)| depth < z) {
                 best = Some((depth, n));
             }
@@ -79,71 +73,133 @@ fn normal_at(
     best.map(|(_, n)| n)
 }
 
+/// The unit direction of the ray through pixel `p` (camera coordinates).
+#[inline]
+pub(super) fn unit_ray(camera: &Camera, p: &Vector2<f32>) -> Vector3<f32> {
+    let ray = camera.ray(p);
+    ray / ray.norm()
+}
+
+/// Where the ray `d` (unit, [`unit_ray`]) through pixel `p` meets `link`, whose capsule in
+/// camera coordinates is `capsule`: the camera depth (mm) and the outward unit normal. `None`
+/// when `p` lies outside the link's image bounds or the ray misses it.
+#[inline]
+pub(super) fn link_hit(
+    link: &ProjectedLink,
+    capsule: &Capsule,
+    d: &Vector3<f32>,
+    p: &Vector2<f32>,
+) -> Option<(f32, Vector3<f32>)> {
+    if !link.bounds.contains(p) {
+        return None;
+    }
+    let (t, n) = capsule.hit(d)?;
+    Some((t * d.z, n))
+}
+
 /// A lattice point's row of the fit: background where no surface is hit, else the hand's grey
 /// and the light's three components times the normal.
-fn row_of(normal: Option<Vector3<f32>>) -> SVector<f32, TERMS> {
+pub(super) fn row_of(normal: Option<Vector3<f32>>) -> SVector<f32, TERMS> {
     match normal {
         Some(n) => SVector::<f32, TERMS>::new(0.0, 1.0, n.x, n.y, n.z),
         None => SVector::<f32, TERMS>::new(1.0, 0.0, 0.0, 0.0, 0.0),
     }
 }
 
-/// The link axis ends of `view` in camera coordinates (mm), as [`normal_at`] takes them.
-fn axis_ends(view: &ProjectedModel, camera: &Camera) -> [(Vector3<f32>, Vector3<f32>); MAX_LINKS] {
-    let mut ends = [(Vector3::zeros(), Vector3::zeros()); MAX_LINKS];
-    for (end, link) in ends.iter_mut().zip(&view.links) {
-        *end = (camera.to_camera(&link.p0), camera.to_camera(&link.p1));
+/// Each link of `view` as a [`Capsule`] in camera coordinates, as [`normal_at`] takes them.
+pub(super) fn capsules(view: &ProjectedModel, camera: &Camera) -> [Capsule; MAX_LINKS] {
+    let mut capsules = [Capsule::default(); MAX_LINKS];
+    for (capsule, link) in capsules.iter_mut().zip(&view.links) {
+        *capsule = Capsule::new(
+            camera.to_camera(&link.p0),
+            camera.to_camera(&link.p1),
+            link.radius_mm,
+        );
     }
-    ends
+    capsules
 }
 
-/// The nearest intersection of the ray `t · d` (t > 0, `d` unit, from the camera centre) with
-/// the capsule `a`–`b` of radius `r` (mm, camera coordinates): `t` and the outward unit normal.
-fn ray_capsule(
-    d: &Vector3<f32>,
-    a: &Vector3<f32>,
-    b: &Vector3<f32>,
+/// A link's capsule in camera coordinates (mm), with what every ray's test of it shares.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct Capsule {
+    /// Axis start and end.
+    a: Vector3<f32>,
+    b: Vector3<f32>,
+    /// Radius (mm).
     r: f32,
-) -> Option<(f32, Vector3<f32>)> {
-    if r.is_nan() || r <= 0.0 {
-        return None;
-    }
-    let ba = b - a;
-    let oa = -a;
-    let baba = ba.dot(&ba);
-    let bard = ba.dot(d);
-    let baoa = ba.dot(&oa);
-    let rdoa = d.dot(&oa);
-    let oaoa = oa.dot(&oa);
-    // The infinite cylinder, kept only where the hit lies between the end caps.
-    let qa = baba - bard * bard;
-    if qa > 1e-6 * baba.max(1.0) {
-        let qb = baba * rdoa - baoa * bard;
-        let qc = baba * oaoa - baoa * baoa - r * r * baba;
-        let h = qb * qb - qa * qc;
-        if h < 0.0 {
-            return None;
-        }
-        let t = (-qb - libm::sqrtf(h)) / qa;
-        let y = baoa + t * bard;
-        if t > 0.0 && y > 0.0 && y < baba {
-            let axis_point = a + ba * (y / baba);
-            return Some((t, (d * t - axis_point) / r));
+    /// `b − a`, and its products with itself and with `−a`; `a · a`.
+    ba: Vector3<f32>,
+    baba: f32,
+    baoa: f32,
+    oaoa: f32,
+}
+
+impl Capsule {
+    /// The capsule `a`–`b` of radius `r` (mm, camera coordinates).
+    pub(super) fn new(a: Vector3<f32>, b: Vector3<f32>, r: f32) -> Self {
+        let ba = b - a;
+        let oa = -a;
+        Capsule {
+            a,
+            b,
+            r,
+            ba,
+            baba: ba.dot(&ba),
+            baoa: ba.dot(&oa),
+            oaoa: oa.dot(&oa),
         }
     }
-    // Otherwise the nearer of the two end spheres.
-    let sphere = |c: &Vector3<f32>| {
-        let bq = d.dot(c);
-        let h = bq * bq - (c.dot(c) - r * r);
-        if h < 0.0 {
+
+    /// The nearest intersection of the ray `t · d` (t > 0, `d` unit, from the camera centre)
+    /// with the capsule: `t` and the outward unit normal. `None` when the ray misses it or the
+    /// radius is not positive.
+    #[inline]
+    pub(super) fn hit(&self, d: &Vector3<f32>) -> Option<(f32, Vector3<f32>)> {
+        let Capsule {
+            a,
+            b,
+            r,
+            ba,
+            baba,
+            baoa,
+            oaoa,
+        } = *self;
+        if r.is_nan() || r <= 0.0 {
             return None;
         }
-        let t = bq - libm::sqrtf(h);
-        (t > 0.0).then(|| (t, (d * t - c) / r))
-    };
-    match (sphere(a), sphere(b)) {
-        (Some(x), Some(y)) => Some(if x.0 <= y.0 { x } else { y }),
-        (x, y) => x.or(y),
+        let oa = -a;
+        let bard = ba.dot(d);
+        let rdoa = d.dot(&oa);
+        // The infinite cylinder, kept only where the hit lies between the end caps.
+        let qa = baba - bard * bard;
+        if qa > 1e-6 * baba.max(1.0) {
+            let qb = baba * rdoa - baoa * bard;
+            let qc = baba * oaoa - baoa * baoa - r * r * baba;
+            let h = qb * qb - qa * qc;
+            if h < 0.0 {
+                return None;
+            }
+            let t = (-qb - libm::sqrtf(h)) / qa;
+            let y = baoa + t * bard;
+            if t > 0.0 && y > 0.0 && y < baba {
+                let axis_point = a + ba * (y / baba);
+                return Some((t, (d * t - axis_point) / r));
+            }
+        }
+        // Otherwise the nearer of the two end spheres.
+        let sphere = |c: &Vector3<f32>| {
+            let bq = d.dot(c);
+            let h = bq * bq - (c.dot(c) - r * r);
+            if h < 0.0 {
+                return None;
+            }
+            let t = bq - libm::sqrtf(h);
+            (t > 0.0).then(|| (t, (d * t - c) / r))
+        };
+        match (sphere(&a), sphere(&b)) {
+            (Some(x), Some(y)) => Some(if x.0 <= y.0 { x } else { y }),
+            (x, y) => x.or(y),
+        }
     }
 }
 
@@ -165,13 +221,13 @@ pub fn fit(
     if !(step.x.is_finite() && step.y.is_finite()) {
         return None;
     }
-    let ends = axis_ends(view, camera);
-    let ends = &ends[..view.links.len().min(MAX_LINKS)];
+    let capsules = capsules(view, camera);
+    let capsules = &capsules[..view.links.len().min(MAX_LINKS)];
     // Each lattice point in the frame: its row of the fit and its grey level.
     let row_at = |i: usize, j: usize| {
         let p = Vector2::new(min.x + step.x * i as f32, min.y + step.y * j as f32);
         let g = frame.sample(p.x, p.y)?;
-        Some((row_of(normal_at(view, camera, ends, &p)), g))
+        Some((row_of(normal_at(view, camera, capsules, &p)), g))
     };
     let mut normal = SMatrix::<f32, TERMS, TERMS>::zeros();
     let mut rhs = SVector::<f32, TERMS>::zeros();
@@ -238,33 +294,71 @@ pub fn residual_in(
     region: &Bounds,
     step_px: f32,
 ) -> Option<RegionResidual> {
-    let step = if step_px.is_finite() {
-        step_px.max(1.0)
-    } else {
-        1.0
-    };
-    let last = Vector2::new(frame.width() as f32 - 1.0, frame.height() as f32 - 1.0);
-    let min = Vector2::new(region.min.x.max(0.0), region.min.y.max(0.0));
-    let max = Vector2::new(region.max.x.min(last.x), region.max.y.min(last.y));
-    if !(min.x <= max.x && min.y <= max.y) {
-        return None;
-    }
-    let columns = libm::floorf((max.x - min.x) / step) as u32 + 1;
-    let rows = libm::floorf((max.y - min.y) / step) as u32 + 1;
-    let ends = axis_ends(view, camera);
-    let ends = &ends[..view.links.len().min(MAX_LINKS)];
+    let lattice = RegionLattice::new(frame, region, step_px)?;
+    let capsules = capsules(view, camera);
+    let capsules = &capsules[..view.links.len().min(MAX_LINKS)];
     let terms = SVector::<f32, TERMS>::from_column_slice(terms);
     let (mut sum_sq, mut points) = (0.0f32, 0u32);
-    for j in 0..rows {
-        for i in 0..columns {
-            let p = Vector2::new(min.x + step * i as f32, min.y + step * j as f32);
-            let Some(g) = frame.sample(p.x, p.y) else {
-                continue;
-            };
-            let e = row_of(normal_at(view, camera, ends, &p)).dot(&terms) - g;
-            sum_sq += e * e;
-            points += 1;
-        }
+    for p in lattice.points() {
+        let Some(g) = frame.sample(p.x, p.y) else {
+            continue;
+        };
+        let e = row_of(normal_at(view, camera, capsules, &p)).dot(&terms) - g;
+        sum_sq += e * e;
+        points += 1;
     }
     (points > 0 && sum_sq.is_finite()).then_some(RegionResidual { sum_sq, points })
+}
+
+/// Every `step`-th pixel of an image region clipped to a frame, row by row: the points
+/// [`residual_in`] and [`super::shading_cache`] sum over, in the order they sum them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct RegionLattice {
+    /// The first point (px).
+    min: Vector2<f32>,
+    /// Between neighbouring points (px, at least 1).
+    step: f32,
+    columns: u32,
+    rows: u32,
+}
+
+impl RegionLattice {
+    /// The lattice over `region` (px) clipped to `frame`, every `step_px` (at least 1 px; 1
+    /// when not finite). `None` when no pixel of the region lies in the frame.
+    pub(super) fn new(frame: &FrameView<'_>, region: &Bounds, step_px: f32) -> Option<Self> {
+        let step = if step_px.is_finite() {
+            step_px.max(1.0)
+        } else {
+            1.0
+        };
+        let last = Vector2::new(frame.width() as f32 - 1.0, frame.height() as f32 - 1.0);
+        let min = Vector2::new(region.min.x.max(0.0), region.min.y.max(0.0));
+        let max = Vector2::new(region.max.x.min(last.x), region.max.y.min(last.y));
+        if !(min.x <= max.x && min.y <= max.y) {
+            return None;
+        }
+        Some(RegionLattice {
+            min,
+            step,
+            columns: libm::floorf((max.x - min.x) / step) as u32 + 1,
+            rows: libm::floorf((max.y - min.y) / step) as u32 + 1,
+        })
+    }
+
+    /// How many points.
+    pub(super) fn len(&self) -> usize {
+        self.columns as usize * self.rows as usize
+    }
+
+    /// The points, row by row (px).
+    pub(super) fn points(&self) -> impl Iterator<Item = Vector2<f32>> + '_ {
+        (0..self.rows).flat_map(move |j| {
+            (0..self.columns).map(move |i| {
+                Vector2::new(
+                    self.min.x + self.step * i as f32,
+                    self.min.y + self.step * j as f32,
+                )
+            })
+        })
+    }
 }

@@ -15,7 +15,8 @@
 use heapless::Vec;
 use nalgebra::Vector2;
 
-use super::shading::{fit, residual_in};
+use super::shading::{fit, residual_in, RegionResidual};
+use super::shading_cache::{moving_frames, CachedRegion, ShadingCache};
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_STATES};
 use crate::frame::FrameView;
@@ -67,14 +68,26 @@ pub struct RefineOutcome {
     pub moves: u8,
     /// Trials scored.
     pub trials: u8,
+    /// Cameras whose region did not fit the cache ([`super::shading_cache::MAX_CACHED_PIXELS`]):
+    /// scored the slow way, every ray against the whole hand (the same sums).
+    pub uncached_cameras: u8,
 }
 
-/// Per camera: the shading fitted at the start and the finger's region, `None` when that
-/// camera gives no fit or sees none of the finger's links.
-type Fits = [Option<([f32; 5], Bounds)>; MAX_CAMERAS];
+/// One camera's shading fitted at the start, the finger's region, and that region's fixed
+/// surfaces when they fit the cache.
+#[derive(Clone, Copy)]
+struct StartFit {
+    terms: [f32; 5],
+    region: Bounds,
+    cached: Option<CachedRegion>,
+}
+
+/// Per camera: its [`StartFit`], `None` when that camera gives no fit or sees none of the
+/// finger's links.
+type Fits = [Option<StartFit>; MAX_CAMERAS];
 
 /// Refines finger `finger` of `state` (one value per model state) on `frames` (one per
-/// camera), in place. `poses` and `view` are working memory. Nothing moves when the state
+/// camera), in place. `poses`, `view` and `cache` are working memory. Nothing moves when the state
 /// cannot be posed, a camera gives no fit or sees none of the finger, or no trial leaves less.
 #[allow(clippy::too_many_arguments)] // the tracker's parts, lent for one call
 pub fn refine_finger(
@@ -86,6 +99,7 @@ pub fn refine_finger(
     state: &mut [f32],
     poses: &mut Poses,
     view: &mut ProjectedModel,
+    cache: &mut ShadingCache,
     config: &ShadingRefineConfig,
 ) -> RefineOutcome {
     let mut outcome = RefineOutcome::default();
@@ -94,20 +108,36 @@ pub fn refine_finger(
         .filter(|&s| fingers.contains(finger, s))
         .take(MAX_FINGER_JOINTS)
         .collect();
-    let Some(fits) = start_fits(model, cameras, frames, &joints, state, poses, view, config) else {
+    let moving = moving_frames(model, &joints);
+    cache.clear();
+    let Some(fits) = start_fits(
+        model, cameras, frames, &joints, &moving, state, poses, view, cache, config,
+    ) else {
         return outcome;
     };
+    outcome.uncached_cameras = fits.iter().flatten().filter(|f| f.cached.is_none()).count() as u8;
     let score = |q: &[f32], poses: &mut Poses, view: &mut ProjectedModel| {
         if poses.update(model, q).is_err() {
             return f32::INFINITY;
         }
         let mut sum = 0.0f32;
         for ((camera, frame), fit) in cameras.iter().zip(frames).zip(&fits) {
-            let Some((terms, region)) = fit else {
+            let Some(fit) = fit else {
                 return f32::INFINITY;
             };
             view.update(model, poses, camera, 0.0);
-            match residual_in(view, camera, frame, terms, region, config.region_step_px) {
+            let residual: Option<RegionResidual> = match &fit.cached {
+                Some(cached) => cache.residual(cached, view, camera, frame, &fit.terms, &moving),
+                None => residual_in(
+                    view,
+                    camera,
+                    frame,
+                    &fit.terms,
+                    &fit.region,
+                    config.region_step_px,
+                ),
+            };
+            match residual {
                 Some(r) => sum += r.sum_sq,
                 None => return f32::INFINITY,
             }
@@ -149,17 +179,21 @@ pub fn refine_finger(
     outcome
 }
 
-/// Each camera's shading fitted at `state` and the region of the links that `joints` move,
-/// widened; `None` when the state cannot be posed or some camera has neither.
+/// Each camera's shading fitted at `state`, the region of the links that `joints` move,
+/// widened, and that region's surfaces that stay put (the links not moving with `moving`, and
+/// the palm) kept in `cache` while it has room; `None` when the state cannot be posed or some
+/// camera has no fit or region.
 #[allow(clippy::too_many_arguments)]
 fn start_fits(
     model: &Model,
     cameras: &[Camera],
     frames: &[FrameView<'_>],
     joints: &[usize],
+    moving: &super::shading_cache::MovingFrames,
     state: &[f32],
     poses: &mut Poses,
     view: &mut ProjectedModel,
+    cache: &mut ShadingCache,
     config: &ShadingRefineConfig,
 ) -> Option<Fits> {
     poses.update(model, state).ok()?;
@@ -182,13 +216,24 @@ fn start_fits(
                 min: a.min.inf(&b.min),
                 max: a.max.sup(&b.max),
             })?;
-        *slot = Some((
-            found.terms,
-            Bounds {
-                min: bounds.min - pad,
-                max: bounds.max + pad,
-            },
-        ));
+        let region = Bounds {
+            min: bounds.min - pad,
+            max: bounds.max + pad,
+        };
+        let cached = cache.fill(
+            view,
+            camera,
+            frame,
+            &found.terms,
+            &region,
+            config.region_step_px,
+            moving,
+        );
+        *slot = Some(StartFit {
+            terms: found.terms,
+            region,
+            cached,
+        });
     }
     Some(fits)
 }
