@@ -443,7 +443,7 @@ impl Tracker {
     }
 
     /// After a frame tracked and not lost: every [`ShadingRefineConfig::every_frames`] calls,
-    /// one finger in turn is moved where the hand's shading in `frames` says it lies
+    /// [`ShadingRefineConfig::fingers_per_call`] fingers in turn are moved where the hand's shading in `frames` says it lies
     /// ([`crate::likelihood::shading_refine`]). The velocity is kept, so the next prediction
     /// goes on from the finger as moved. Off by default (`every_frames` 0: nothing happens,
     /// and nothing is counted). A frame of the wrong size is an error and moves nothing.
@@ -462,22 +462,30 @@ impl Tracker {
         if !self.shading_calls.is_multiple_of(every) {
             return Ok(RefineOutcome::default());
         }
-        let finger = ((self.shading_calls / every) % count) as usize;
+        let per_call = u32::from(config.fingers_per_call.max(1)).min(count);
+        let first = (self.shading_calls / every).wrapping_mul(per_call);
         let mut q = self.state.clone();
-        // The last iteration's first view is spent: the next frame projects afresh.
-        let work = &mut self.work;
-        let outcome = refine_finger(
-            &self.model,
-            &self.cameras,
-            frames,
-            &self.fingers,
-            finger,
-            &mut q,
-            &mut work.poses,
-            &mut work.views[0],
-            &mut work.shading,
-            &config,
-        );
+        let mut outcome = RefineOutcome::default();
+        for k in 0..per_call {
+            let finger = (first.wrapping_add(k) % count) as usize;
+            // The last iteration's first view is spent: the next frame projects afresh.
+            let work = &mut self.work;
+            let one = refine_finger(
+                &self.model,
+                &self.cameras,
+                frames,
+                &self.fingers,
+                finger,
+                &mut q,
+                &mut work.poses,
+                &mut work.views[0],
+                &mut work.shading,
+                &config,
+            );
+            outcome.moves = outcome.moves.saturating_add(one.moves);
+            outcome.trials = outcome.trials.saturating_add(one.trials);
+            outcome.uncached_cameras = outcome.uncached_cameras.max(one.uncached_cameras);
+        }
         if outcome.moves > 0 {
             self.state = q;
         }

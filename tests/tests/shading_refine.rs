@@ -177,6 +177,56 @@ fn the_tracker_refines_only_when_asked_and_refuses_a_wrong_frame() {
 }
 
 #[test]
+fn several_fingers_a_call_are_the_fingers_in_turn_one_after_another() {
+    // Three fingers a call from the tracker: the same state as refining those three in turn,
+    // each from the one before. Call n takes fingers 3n, 3n + 1, 3n + 2 (mod 5), so the
+    // first (n = 1, as one finger a call takes finger 1 first) takes 3, 4 and 0.
+    let dir = tempfile::tempdir().unwrap();
+    let sequence = common::seeded(dir.path(), "random-mono", 303, 2);
+    let images = frames::images(&sequence, 1);
+    let views = frames::views(&images);
+    let fingers = Fingers::of(&sequence.model);
+    let mut config = TrackerConfig::default();
+    config.shading_refine.every_frames = 1;
+    config.shading_refine.fingers_per_call = 3;
+    let mut tracker = sequence_tracker(&sequence, config).unwrap();
+    tracker.track(&views).unwrap();
+    let mut memory = tracker.memory();
+    for f in 0..fingers.count() {
+        for s in (0..memory.state.len())
+            .filter(|&s| fingers.contains(f, s))
+            .skip(1)
+        {
+            memory.state[s] += 0.1;
+        }
+    }
+    tracker.restore(&memory).unwrap();
+    let outcome = tracker.refine_shading(&views).unwrap();
+    let mut expected = memory.state.to_vec();
+    let mut trials = 0;
+    for f in [3, 4, 0] {
+        let mut poses = Poses::compute(&sequence.model, &expected).unwrap();
+        let mut view = ProjectedModel::new();
+        let one = refine_finger(
+            &sequence.model,
+            &sequence.cameras,
+            &views,
+            &fingers,
+            f,
+            &mut expected,
+            &mut poses,
+            &mut view,
+            &mut ShadingCache::default(),
+            &config.shading_refine,
+        );
+        trials += one.trials;
+    }
+    assert_eq!(outcome.trials, trials);
+    assert!(outcome.moves > 0, "{outcome:?}");
+    assert_eq!(tracker.state(), &expected[..]);
+}
+
+#[test]
 fn the_whole_pipeline_with_the_refinement_tracks_a_friendly_hand_as_well() {
     // `fullhand-stereo` (seed 1, 20 frames at 640×480) through `track_sequence`, the status
     // machine and all, with a finger refined after every frame: it runs (the states differ

@@ -35,6 +35,9 @@ pub struct ShadingRefineConfig {
     /// Refine one finger (in turn) after every this many frames tracked (0: never, the
     /// default; the tracker as before, bit for bit).
     pub every_frames: u8,
+    /// Fingers refined at each such frame, each in turn (at least 1; 1 by default: two or
+    /// all five a frame measured worse on fresh seeds, `docs/robustness.md`).
+    pub fingers_per_call: u8,
     /// The shading fit's lattice side (2..=[`super::shading::MAX_SHADING_GRID`]).
     pub grid: u8,
     /// The residual's pixel step over the finger's region (px, at least 1).
@@ -43,7 +46,9 @@ pub struct ShadingRefineConfig {
     pub region_pad_px: f32,
     /// The steps tried on each joint, in order (rad; 0 skips one).
     pub steps_rad: [f32; 3],
-    /// A trial is kept when it leaves less than `1 − margin` of the best residual so far.
+    /// A trial is kept when it leaves less than `1 − margin` of the best residual so far
+    /// (0.005 by default: on fresh seeds a finger then moves only where its shading clearly
+    /// says so, and fewer tracks are lost to a move than with none; `docs/robustness.md`).
     pub margin: f32,
 }
 
@@ -51,11 +56,12 @@ impl Default for ShadingRefineConfig {
     fn default() -> Self {
         ShadingRefineConfig {
             every_frames: 0,
+            fingers_per_call: 1,
             grid: 64,
             region_step_px: 2.0,
             region_pad_px: 20.0,
             steps_rad: [0.08, 0.04, 0.02],
-            margin: 0.0,
+            margin: 0.005,
         }
     }
 }

@@ -99,6 +99,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "fillend" => c.fill.full_length_widths = f,
             "shade" => c.shading_refine.every_frames = f as u8,
             "shadegrid" => c.shading_refine.grid = f as u8,
+            "shadefingers" => c.shading_refine.fingers_per_call = f as u8,
             "shadestep" => c.shading_refine.region_step_px = f,
             "shademargin" => c.shading_refine.margin = f,
             "lostrms" => c.lost_rms_px = f,
