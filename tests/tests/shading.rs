@@ -6,7 +6,7 @@
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::fingers::Fingers;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::likelihood::shading::{fit, residual_in, ShadingFit};
+use digiteyes_core::likelihood::shading::{fit, fit_terms, residual_in, ShadingFit};
 use digiteyes_core::nalgebra::Vector2;
 use digiteyes_core::projection::{Bounds, ProjectedModel};
 use digiteyes_core::silhouette::hand_bounds;
@@ -148,6 +148,34 @@ fn no_hand_in_view_gives_no_fit() {
     let mut q: Vec<f32> = truth.rows[0].iter().map(|&v| v as f32).collect();
     q[4] += 5000.0;
     assert_eq!(fit_at(&sequence, 0, &q), None);
+}
+
+#[test]
+fn the_terms_alone_are_the_fits_terms_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut fits = 0;
+    for seed in seeds() {
+        let sequence = common::seeded(dir.path(), "random-mono", seed, 20);
+        let fingers = Fingers::of(&sequence.model);
+        let truth = sequence.read_truth().unwrap();
+        for k in [0, 19] {
+            let q: Vec<f32> = truth.rows[k].iter().map(|&v| v as f32).collect();
+            let image = image_of(&sequence, k);
+            let frame = frame_of(&image);
+            let nothing = fit_terms(&ProjectedModel::new(), &sequence.cameras[0], &frame, GRID);
+            assert_eq!(nothing, None, "no hand, no terms");
+            for state in [q.clone(), bent(&q, &fingers, 1, 0.5)] {
+                let view = view_of(&sequence, &state);
+                for grid in [16, GRID] {
+                    let whole = fit(&view, &sequence.cameras[0], &frame, grid);
+                    let terms = fit_terms(&view, &sequence.cameras[0], &frame, grid);
+                    assert_eq!(whole.map(|f| f.terms), terms, "seed {seed} frame {k}");
+                    fits += usize::from(terms.is_some());
+                }
+            }
+        }
+    }
+    assert!(fits >= 48, "{fits} fits");
 }
 
 #[test]

@@ -213,28 +213,105 @@ pub fn fit(
     frame: &FrameView<'_>,
     grid: usize,
 ) -> Option<ShadingFit> {
-    let grid = grid.clamp(2, MAX_SHADING_GRID);
-    let bounds = hand_bounds(view)?;
-    let size = bounds.max - bounds.min;
-    let min = bounds.min - size * 0.25;
-    let step = size * (1.5 / (grid - 1) as f32);
-    if !(step.x.is_finite() && step.y.is_finite()) {
-        return None;
-    }
+    let lattice = FitLattice::over(view, grid)?;
     let capsules = capsules(view, camera);
     let capsules = &capsules[..view.links.len().min(MAX_LINKS)];
-    // Each lattice point in the frame: its row of the fit and its grey level.
-    let row_at = |i: usize, j: usize| {
-        let p = Vector2::new(min.x + step.x * i as f32, min.y + step.y * j as f32);
+    let (terms, points, on_hand) = solve(view, camera, frame, &lattice, capsules)?;
+    // The residual, in a second pass: exact in f32, where `gᵀg − tᵀAᵀg` would cancel.
+    let mut sum = 0.0f32;
+    for j in 0..lattice.grid {
+        for i in 0..lattice.grid {
+            if let Some((row, g)) = lattice.row_at(view, camera, capsules, frame, i, j) {
+                let e = row.dot(&terms) - g;
+                sum += e * e;
+            }
+        }
+    }
+    let rms = libm::sqrtf(sum / f32::from(points));
+    (rms.is_finite() && terms.iter().all(|t| t.is_finite())).then_some(ShadingFit {
+        rms,
+        points,
+        on_hand,
+        terms: [terms[0], terms[1], terms[2], terms[3], terms[4]],
+    })
+}
+
+/// [`fit`]'s terms alone, the same bits, without the residual's second pass over the lattice
+/// (half the rays). `None` as for [`fit`], but for a residual that overflows.
+pub fn fit_terms(
+    view: &ProjectedModel,
+    camera: &Camera,
+    frame: &FrameView<'_>,
+    grid: usize,
+) -> Option<[f32; TERMS]> {
+    let lattice = FitLattice::over(view, grid)?;
+    let capsules = capsules(view, camera);
+    let capsules = &capsules[..view.links.len().min(MAX_LINKS)];
+    let (terms, _, _) = solve(view, camera, frame, &lattice, capsules)?;
+    terms
+        .iter()
+        .all(|t| t.is_finite())
+        .then_some([terms[0], terms[1], terms[2], terms[3], terms[4]])
+}
+
+/// The lattice [`fit`] samples: `grid × grid` points over the hand's bounds widened by a
+/// quarter on each side.
+struct FitLattice {
+    /// The first point (px).
+    min: Vector2<f32>,
+    /// Between neighbouring points (px).
+    step: Vector2<f32>,
+    /// Points a side (2..=[`MAX_SHADING_GRID`]).
+    grid: usize,
+}
+
+impl FitLattice {
+    /// The lattice over `view`'s hand, `grid` (clamped) a side; `None` when the hand
+    /// projects nowhere or the steps are not finite.
+    fn over(view: &ProjectedModel, grid: usize) -> Option<Self> {
+        let grid = grid.clamp(2, MAX_SHADING_GRID);
+        let bounds = hand_bounds(view)?;
+        let size = bounds.max - bounds.min;
+        let min = bounds.min - size * 0.25;
+        let step = size * (1.5 / (grid - 1) as f32);
+        (step.x.is_finite() && step.y.is_finite()).then_some(FitLattice { min, step, grid })
+    }
+
+    /// Point `(i, j)`'s row of the fit and the frame's grey level there; `None` outside the
+    /// frame.
+    fn row_at(
+        &self,
+        view: &ProjectedModel,
+        camera: &Camera,
+        capsules: &[Capsule],
+        frame: &FrameView<'_>,
+        i: usize,
+        j: usize,
+    ) -> Option<(SVector<f32, TERMS>, f32)> {
+        let p = Vector2::new(
+            self.min.x + self.step.x * i as f32,
+            self.min.y + self.step.y * j as f32,
+        );
         let g = frame.sample(p.x, p.y)?;
         Some((row_of(normal_at(view, camera, capsules, &p)), g))
-    };
+    }
+}
+
+/// The least-squares terms over `lattice`, the points in the frame and those on the hand;
+/// `None` with too few of either or a singular system.
+fn solve(
+    view: &ProjectedModel,
+    camera: &Camera,
+    frame: &FrameView<'_>,
+    lattice: &FitLattice,
+    capsules: &[Capsule],
+) -> Option<(SVector<f32, TERMS>, u16, u16)> {
     let mut normal = SMatrix::<f32, TERMS, TERMS>::zeros();
     let mut rhs = SVector::<f32, TERMS>::zeros();
     let (mut points, mut on_hand) = (0u16, 0u16);
-    for j in 0..grid {
-        for i in 0..grid {
-            let Some((row, g)) = row_at(i, j) else {
+    for j in 0..lattice.grid {
+        for i in 0..lattice.grid {
+            let Some((row, g)) = lattice.row_at(view, camera, capsules, frame, i, j) else {
                 continue;
             };
             normal += row * row.transpose();
@@ -250,24 +327,7 @@ pub fn fit(
     for k in 2..TERMS {
         normal[(k, k)] += 1e-3 * f32::from(on_hand);
     }
-    let terms = normal.cholesky()?.solve(&rhs);
-    // The residual, in a second pass: exact in f32, where `gᵀg − tᵀAᵀg` would cancel.
-    let mut sum = 0.0f32;
-    for j in 0..grid {
-        for i in 0..grid {
-            if let Some((row, g)) = row_at(i, j) {
-                let e = row.dot(&terms) - g;
-                sum += e * e;
-            }
-        }
-    }
-    let rms = libm::sqrtf(sum / f32::from(points));
-    (rms.is_finite() && terms.iter().all(|t| t.is_finite())).then_some(ShadingFit {
-        rms,
-        points,
-        on_hand,
-        terms: [terms[0], terms[1], terms[2], terms[3], terms[4]],
-    })
+    Some((normal.cholesky()?.solve(&rhs), points, on_hand))
 }
 
 /// The squared residual of a shading already fitted ([`ShadingFit::terms`]) over a region of

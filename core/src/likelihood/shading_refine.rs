@@ -15,7 +15,7 @@
 use heapless::Vec;
 use nalgebra::Vector2;
 
-use super::shading::{fit, residual_in, RegionResidual};
+use super::shading::{fit_terms, residual_in, RegionResidual};
 use super::shading_cache::{moving_frames, CachedRegion, ShadingCache};
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_STATES};
@@ -46,6 +46,12 @@ pub struct ShadingRefineConfig {
     pub region_pad_px: f32,
     /// The steps tried on each joint, in order (rad; 0 skips one).
     pub steps_rad: [f32; 3],
+    /// Also try the finger's flexions (all its joint states but the first) moved together, a
+    /// curl, before its joints one by one (false by default).
+    pub curl: bool,
+    /// Try each flexion alone (true by default; false leaves the first joint state alone and
+    /// the flexions together, keeping how the bend is split among them).
+    pub single_flexions: bool,
     /// A trial is kept when it leaves less than `1 − margin` of the best residual so far
     /// (0.005 by default: on fresh seeds a finger then moves only where its shading clearly
     /// says so, and fewer tracks are lost to a move than with none; `docs/robustness.md`).
@@ -61,6 +67,8 @@ impl Default for ShadingRefineConfig {
             region_step_px: 2.0,
             region_pad_px: 20.0,
             steps_rad: [0.08, 0.04, 0.02],
+            curl: false,
+            single_flexions: true,
             margin: 0.005,
         }
     }
@@ -159,7 +167,33 @@ pub fn refine_finger(
         if !(step.is_finite() && step > 0.0) {
             continue;
         }
-        for &s in &joints {
+        for (k, &s) in joints.iter().enumerate() {
+            // The finger's flexions together (all its joints but the first), then each joint.
+            if k == 0 && config.curl && joints.len() > 2 {
+                let flexions = &joints[1..];
+                for sign in [1.0f32, -1.0] {
+                    trial[..n].copy_from_slice(&state[..n]);
+                    for &f in flexions {
+                        if let Some(limit) = model.limit(f) {
+                            trial[f] = (state[f] + sign * step).clamp(limit.lo, limit.hi);
+                        }
+                    }
+                    if flexions.iter().all(|&f| trial[f] == state[f]) {
+                        continue;
+                    }
+                    outcome.trials = outcome.trials.saturating_add(1);
+                    let residual = score(&trial[..n], poses, view);
+                    if residual < best * (1.0 - config.margin) {
+                        best = residual;
+                        state[..n].copy_from_slice(&trial[..n]);
+                        outcome.moves = outcome.moves.saturating_add(1);
+                        break;
+                    }
+                }
+            }
+            if k > 0 && !config.single_flexions {
+                continue;
+            }
             let Some(limit) = model.limit(s) else {
                 continue;
             };
@@ -212,7 +246,7 @@ fn start_fits(
     let mut fits: Fits = [None; MAX_CAMERAS];
     for ((camera, frame), slot) in cameras.iter().zip(frames).zip(fits.iter_mut()) {
         view.update(model, poses, camera, 0.0);
-        let found = fit(view, camera, frame, usize::from(config.grid))?;
+        let terms = fit_terms(view, camera, frame, usize::from(config.grid))?;
         let bounds = view
             .links
             .iter()
@@ -230,13 +264,13 @@ fn start_fits(
             view,
             camera,
             frame,
-            &found.terms,
+            &terms,
             &region,
             config.region_step_px,
             moving,
         );
         *slot = Some(StartFit {
-            terms: found.terms,
+            terms,
             region,
             cached,
         });

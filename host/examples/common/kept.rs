@@ -100,6 +100,8 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "shade" => c.shading_refine.every_frames = f as u8,
             "shadegrid" => c.shading_refine.grid = f as u8,
             "shadefingers" => c.shading_refine.fingers_per_call = f as u8,
+            "shadecurl" => c.shading_refine.curl = f != 0.0,
+            "shadesingle" => c.shading_refine.single_flexions = f != 0.0,
             "shadestep" => c.shading_refine.region_step_px = f,
             "shademargin" => c.shading_refine.margin = f,
             "lostrms" => c.lost_rms_px = f,
