@@ -56,9 +56,26 @@ fn normal_at(
     capsules: &[Capsule],
     p: &Vector2<f32>,
 ) -> Option<Vector3<f32>> {
+    nearest_surface(view, camera, capsules, p, |_| false).map(|(_, n)| n)
+}
+
+/// The nearest surface of `view` on the ray through pixel `p`, leaving out the links `skip`
+/// picks: its camera depth (mm) and outward unit normal (camera coordinates); the links in
+/// order, then the palm, a later one taken only when strictly nearer.
+#[inline]
+pub(super) fn nearest_surface(
+    view: &ProjectedModel,
+    camera: &Camera,
+    capsules: &[Capsule],
+    p: &Vector2<f32>,
+    skip: impl Fn(&ProjectedLink) -> bool,
+) -> Option<(f32, Vector3<f32>)> {
     let d = unit_ray(camera, p);
     let mut best: Option<(f32, Vector3<f32>)> = None;
     for (link, capsule) in view.links.iter().zip(capsules) {
+        if skip(link) {
+            continue;
+        }
         if let Some((depth, n)) = link_hit(link, capsule, &d, p) {
             if best.is_none_or(|(z, _)| depth < z) {
                 best = Some((depth, n));
@@ -70,7 +87,7 @@ fn normal_at(
             best = Some((depth, n));
         }
     }
-    best.map(|(_, n)| n)
+    best
 }
 
 /// The unit direction of the ray through pixel `p` (camera coordinates).

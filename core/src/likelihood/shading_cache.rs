@@ -10,7 +10,9 @@
 
 use nalgebra::{SVector, Vector3};
 
-use super::shading::{capsules, link_hit, row_of, unit_ray, RegionLattice, RegionResidual, TERMS};
+use super::shading::{
+    capsules, link_hit, nearest_surface, row_of, unit_ray, RegionLattice, RegionResidual, TERMS,
+};
 use crate::camera::Camera;
 use crate::config::MAX_LINKS;
 use crate::frame::FrameView;
@@ -133,23 +135,9 @@ impl ShadingCache {
                 *pixel = UNSAMPLED;
                 continue;
             };
-            let d = unit_ray(camera, &p);
-            let mut best: Option<(f32, Vector3<f32>)> = None;
-            for (link, capsule) in view.links.iter().zip(&capsules) {
-                if link_moves(moving, link.frame, link.child) {
-                    continue;
-                }
-                if let Some((depth, n)) = link_hit(link, capsule, &d, &p) {
-                    if best.is_none_or(|(z, _)| depth < z) {
-                        best = Some((depth, n));
-                    }
-                }
-            }
-            if let Some((depth, n)) = view.palm.as_ref().and_then(|palm| palm.hit_at(camera, &p)) {
-                if best.is_none_or(|(z, _)| depth < z) {
-                    best = Some((depth, n));
-                }
-            }
+            let best = nearest_surface(view, camera, &capsules, &p, |link| {
+                link_moves(moving, link.frame, link.child)
+            });
             let e = row_of(best.map(|(_, n)| n)).dot(&terms) - g;
             *pixel = FixedPixel {
                 residual_sq: e * e,
