@@ -131,13 +131,28 @@ fn a_region_beyond_the_room_left_is_refused_and_clear_makes_room() {
     let slow = residual_in(&view, camera, frame, &terms, &region, 1.0).unwrap();
     assert_eq!(slow.points, 6144);
     assert_eq!(
-        cache.residual(&first.unwrap(), &view, camera, frame, &terms, &moving),
+        cache.residual(
+            first.as_ref().unwrap(),
+            &view,
+            camera,
+            frame,
+            &terms,
+            &moving
+        ),
         Some(slow)
     );
+    let first = first.unwrap();
     cache.clear();
-    assert!(cache
-        .fill(&view, camera, frame, &terms, &region, 1.0, &moving)
-        .is_some());
+    assert_eq!(
+        cache.residual(&first, &view, camera, frame, &terms, &moving),
+        None,
+        "a region kept before a clear is gone"
+    );
+    let again = cache.fill(&view, camera, frame, &terms, &region, 1.0, &moving);
+    assert_eq!(
+        cache.residual(&again.unwrap(), &view, camera, frame, &terms, &moving),
+        Some(slow)
+    );
     // A cache with no room keeps nothing; a region outside the frame is none at all.
     let mut none = ShadingCache::with_room(0);
     assert_eq!(

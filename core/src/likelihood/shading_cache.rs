@@ -56,6 +56,8 @@ pub struct ShadingCache {
     used: usize,
     /// Pixels it may use (at most [`MAX_CACHED_PIXELS`]).
     room: usize,
+    /// Times cleared: a region kept before the last clear is no longer here.
+    generation: u32,
 }
 
 impl Default for ShadingCache {
@@ -70,6 +72,8 @@ pub struct CachedRegion {
     lattice: RegionLattice,
     /// Its first pixel in the cache.
     start: usize,
+    /// The cache's generation when it was kept.
+    generation: u32,
 }
 
 /// The model frames that any of `joints` (states) moves: every frame whose chain holds one.
@@ -97,12 +101,14 @@ impl ShadingCache {
             pixels: [UNSAMPLED; MAX_CACHED_PIXELS],
             used: 0,
             room: room.min(MAX_CACHED_PIXELS),
+            generation: 0,
         }
     }
 
     /// Forgets every region kept.
     pub fn clear(&mut self) {
         self.used = 0;
+        self.generation = self.generation.wrapping_add(1);
     }
 
     /// Keeps, for every `step_px`-th pixel of `region` (as [`super::shading::residual_in`]
@@ -145,7 +151,11 @@ impl ShadingCache {
             };
         }
         self.used = end;
-        Some(CachedRegion { lattice, start })
+        Some(CachedRegion {
+            lattice,
+            start,
+            generation: self.generation,
+        })
     }
 
     /// The residual of `terms` over `cached` (kept by [`ShadingCache::fill`] for this camera,
@@ -163,7 +173,10 @@ impl ShadingCache {
         moving: &MovingFrames,
     ) -> Option<RegionResidual> {
         let end = cached.start.checked_add(cached.lattice.len())?;
-        let pixels = self.pixels.get(cached.start..end.min(self.used))?;
+        if cached.generation != self.generation || end > self.used {
+            return None;
+        }
+        let pixels = self.pixels.get(cached.start..end)?;
         let capsules = capsules(view, camera);
         let mut free: heapless::Vec<usize, MAX_LINKS> = heapless::Vec::new();
         let mut reach: Option<Bounds> = None;
