@@ -12,7 +12,11 @@
 //! its period, `drop` its bar; `depth1` one camera's local depth share; `turn` the local
 //! re-acquisition's palm turn (rad); `probation` the acceptance's probation drop, negative:
 //! off; `budget` the search's evaluations a frame and camera; `pursue1` the searching frames
-//! one camera pursues a refused leaf, 0: never). Each group's row also gives its frames far from the hand and not flagged (`far`)
+//! one camera pursues a refused leaf, 0: never); `shade` the shading refinement's period,
+//! `shadegrid` its fit's lattice, `shadestep` its region's pixel step, `shademargin` its
+//! margin, `shadefingers` its fingers a call, `shadecurl` and `shadesingle` its moves (0 / 1),
+//! `shaderad` its first step (rad; then half and a quarter), `shadelevels` how many steps).
+//! Each group's row also gives its frames far from the hand and not flagged (`far`)
 //! and the lost flag's precision and recall (`lostP`, `lostR`), as the benchmark counts them,
 //! and the median share of frames held (`held50`, as `eval`'s frames held).
 //! Every variant after the first is also compared with the first seed by seed (paired):

@@ -76,13 +76,15 @@ pub struct CachedRegion {
     generation: u32,
 }
 
-/// The model frames that any of `joints` (states) moves: every frame whose chain holds one.
+/// The model frames that any of `joints` (states) moves: every frame whose chain holds one
+/// (and, to be safe, any whose chain cannot be read: a moving frame taken as fixed would
+/// corrupt the cache's sums; a fixed one taken as moving only costs rays).
 pub fn moving_frames(model: &Model, joints: &[usize]) -> MovingFrames {
     let mut moving = [false; MAX_LINKS];
     for (f, slot) in moving.iter_mut().enumerate().take(model.links().len()) {
         *slot = model
             .chain(f)
-            .is_some_and(|chain| chain.iter().any(|&s| joints.contains(&usize::from(s))));
+            .is_none_or(|chain| chain.iter().any(|&s| joints.contains(&usize::from(s))));
     }
     moving
 }

@@ -103,6 +103,12 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "shadecurl" => c.shading_refine.curl = f != 0.0,
             "shadesingle" => c.shading_refine.single_flexions = f != 0.0,
             "shadestep" => c.shading_refine.region_step_px = f,
+            "shaderad" => c.shading_refine.steps_rad = [f, f / 2.0, f / 4.0],
+            "shadelevels" => {
+                for step in c.shading_refine.steps_rad.iter_mut().skip(f as usize) {
+                    *step = 0.0;
+                }
+            }
             "shademargin" => c.shading_refine.margin = f,
             "lostrms" => c.lost_rms_px = f,
             "sdrop" => c.lost_silhouette_drop = f,
