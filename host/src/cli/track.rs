@@ -64,7 +64,7 @@ pub struct TrackArgs {
     #[arg(long)]
     pub no_predict: bool,
     /// After every N-th frame tracked, move one finger in turn where the hand's shading
-    /// says it lies (0: never, the default). Costs up to 30 residuals over a finger a frame;
+    /// says it lies (0: never, the default). Costs up to 20 residuals over a finger a frame;
     /// docs/robustness.md, "The shading pulls a finger back".
     #[arg(long, value_name = "N")]
     pub shading_refine: Option<u8>,
