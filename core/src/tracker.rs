@@ -444,9 +444,10 @@ impl Tracker {
 
     /// After a frame tracked and not lost: every [`ShadingRefineConfig::every_frames`] calls,
     /// [`ShadingRefineConfig::fingers_per_call`] fingers in turn are moved where the hand's
-    /// shading in `frames` says it lies ([`crate::likelihood::shading_refine`]). The velocity is kept, so the next prediction
-    /// goes on from the finger as moved. Off by default (`every_frames` 0: nothing happens,
-    /// and nothing is counted). A frame of the wrong size is an error and moves nothing.
+    /// shading in `frames` says it lies ([`crate::likelihood::shading_refine`]). The velocity
+    /// is kept, so the next prediction goes on from the finger as moved. Off by default
+    /// (`every_frames` 0: nothing happens, and nothing is counted). A frame of the wrong size
+    /// is an error and moves nothing.
     pub fn refine_shading(
         &mut self,
         frames: &[FrameView<'_>],
