@@ -133,6 +133,7 @@ impl Bases {
                 ambient,
                 toward_light,
             },
+            surface: Default::default(),
             threads: 0,
         };
         let axis = |k: usize, sign: f64| {

@@ -4,7 +4,7 @@
 
 use digiteyes_core::model::Model;
 use digiteyes_host::bench::robustness::{run, Motion, RobustnessArgs};
-use digiteyes_host::scenarios::{generate, RenderOptions};
+use digiteyes_host::scenarios::{generate, RenderOptions, SurfaceChoice};
 
 fn options(seed: u64) -> RenderOptions {
     RenderOptions {
@@ -100,17 +100,23 @@ fn the_benchmark_runs_a_tiny_sweep() {
         keep: None,
         gallery: Some(dir.path().join("gallery")),
         fixed_light: false,
+        surface: SurfaceChoice::Varied,
         shading_refine: 1,
     };
     let sweep = run(&args).unwrap();
     assert!(sweep.failed.is_empty(), "{:?}", sweep.failed);
     assert_eq!(sweep.seeds.len(), 2);
-    // The shading refinement was asked for, and the table and the JSON say so.
-    assert!(sweep
-        .to_string()
-        .contains("refined by its shading after every frame"));
+    // The shading refinement and the varied surface were asked for, and the table and the
+    // JSON say so.
+    let table = sweep.to_string();
+    assert!(
+        table.contains("refined by its shading after every frame"),
+        "{table}"
+    );
+    assert!(table.contains("a varied surface"), "{table}");
     let json = std::fs::read_to_string(dir.path().join("sweep.json")).unwrap();
     assert!(json.contains("\"shading_refine\": 1"), "{json}");
+    assert!(json.contains("\"surface\": \"varied\""), "{json}");
     // The gallery holds each camera's frame where a seed was first truly lost, and only those.
     let mut expected: Vec<String> = sweep
         .seeds
@@ -172,6 +178,7 @@ fn a_small_sweep_holds_the_hand_better_than_the_plain_loop() {
             keep: None,
             gallery: None,
             fixed_light: false,
+            surface: SurfaceChoice::Matte,
             shading_refine: 0,
         })
         .unwrap()

@@ -9,7 +9,7 @@ use std::time::Instant;
 use common::FIXTURE;
 use digiteyes_core::model::Model;
 use digiteyes_host::render::Renderer;
-use digiteyes_host::scenarios::{generate, measure, RenderOptions, NAMES};
+use digiteyes_host::scenarios::{generate, measure, RenderOptions, SurfaceChoice, NAMES};
 use digiteyes_host::sequence::Sequence;
 
 fn opts(seed: u64) -> RenderOptions {
@@ -187,4 +187,50 @@ fn clutter_puts_texture_behind_the_hand() {
     let mean = corner.iter().sum::<f64>() / corner.len() as f64;
     let sd = (corner.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / corner.len() as f64).sqrt();
     assert!(sd > 8.0, "background sd {sd}");
+}
+
+#[test]
+fn a_varied_surface_changes_the_hand_alone() {
+    let model = Model::hand().unwrap();
+    let seed = 14;
+    let matte = generate("random-stereo", &opts(seed)).unwrap();
+    let varied = RenderOptions {
+        surface: SurfaceChoice::Varied,
+        ..opts(seed)
+    };
+    let varied = generate("random-stereo", &varied).unwrap();
+    assert_eq!(matte.truth, varied.truth, "the motion is the matte seed's");
+    assert_eq!(matte.cameras, varied.cameras, "the rig is the matte seed's");
+    assert_eq!(matte.settings.lighting, varied.settings.lighting);
+    assert!(matte.settings.surface.is_matte() && !varied.settings.surface.is_matte());
+    let q: Vec<f32> = matte.truth[20].iter().map(|&v| v as f32).collect();
+    for camera in &matte.cameras {
+        let plain = Renderer::new(&model, camera, matte.settings);
+        let rough = Renderer::new(&model, camera, varied.settings);
+        let (a, b) = (plain.render(&q, 5).unwrap(), rough.render(&q, 5).unwrap());
+        let coverage = plain.coverage(&q).unwrap();
+        let (w, h) = (camera.width as usize, camera.height as usize);
+        // Past the blur's reach of every hand pixel, the frames are the same, noise and all.
+        let near_hand = |x: usize, y: usize| {
+            let (x0, y0) = (x.saturating_sub(6), y.saturating_sub(6));
+            (y0..(y + 7).min(h)).any(|j| (x0..(x + 7).min(w)).any(|i| coverage[j * w + i] > 0.0))
+        };
+        let (mut hand, mut changed) = (0, 0);
+        for y in 0..h {
+            for x in 0..w {
+                let (pa, pb) = (
+                    a.get_pixel(x as u32, y as u32).0[0],
+                    b.get_pixel(x as u32, y as u32).0[0],
+                );
+                if !near_hand(x, y) {
+                    assert_eq!(pa, pb, "background pixel ({x}, {y})");
+                } else if coverage[y * w + x] == 1.0 {
+                    hand += 1;
+                    changed += usize::from(pa.abs_diff(pb) >= 2);
+                }
+            }
+        }
+        println!("{changed} of {hand} hand pixels changed by 2 grey levels or more");
+        assert!(hand > 1000 && changed * 2 > hand, "{changed} of {hand}");
+    }
 }

@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use crate::eval::{evaluate, stats, EvalReport};
 use crate::render::Lighting;
-use crate::scenarios::{render_scenario, RenderOptions};
+use crate::scenarios::{render_scenario, RenderOptions, SurfaceChoice};
 use crate::sequence::states::read_states_with_gaps;
 use crate::sequence::Sequence;
 use crate::track::track_sequence_with;
@@ -95,6 +95,12 @@ pub struct RobustnessArgs {
     /// measured under it.
     #[arg(long)]
     pub fixed_light: bool,
+    /// The hand's surface in every seed: `matte` (one grey, as the tracker's shading fit
+    /// assumes; the sweep's figures in docs/robustness.md) or `varied` (each part its own
+    /// grey, a glossy highlight, shadows the hand casts on itself; drawn from each seed,
+    /// which keeps its rig, motion and light).
+    #[arg(long, value_enum, default_value_t = SurfaceChoice::Matte)]
+    pub surface: SurfaceChoice,
     /// After every N-th frame tracked, move one finger in turn where the hand's shading says
     /// it lies, as `track --shading-refine N` (0: never, the default).
     #[arg(long, value_name = "N", default_value_t = 0)]
@@ -252,6 +258,7 @@ pub fn run_seed(seed: u64, args: &RobustnessArgs, dir: &Path) -> Result<SeedResu
         size: Some(args.size),
         supersample: 2,
         lighting: args.fixed_light.then(Lighting::default),
+        surface: args.surface,
         ..RenderOptions::default()
     };
     render_scenario(name, &seq, &options).with_context(|| format!("seed {seed}"))?;
@@ -356,6 +363,7 @@ pub fn run(args: &RobustnessArgs) -> Result<Sweep> {
         frames: args.frames,
         size: args.size,
         fixed_light: args.fixed_light,
+        surface: args.surface,
         seeds,
         failed,
     };
@@ -379,6 +387,8 @@ pub struct Sweep {
     pub size: (u32, u32),
     /// Every seed lit by the fixed light (`--fixed-light`), not its own.
     pub fixed_light: bool,
+    /// The hand's surface in every seed (`--surface`).
+    pub surface: SurfaceChoice,
     /// Every seed tracked.
     pub seeds: Vec<SeedResult>,
     /// Seeds that could not be rendered or tracked, and why.
@@ -475,11 +485,20 @@ impl fmt::Display for Sweep {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "robustness sweep: {} seeds x {} frames at {}x{}, tracker: {:?}{}",
+            "robustness sweep: {} seeds x {} frames at {}x{}{}{}, tracker: {:?}{}",
             self.seeds.len(),
             self.frames,
             self.size.0,
             self.size.1,
+            if self.fixed_light {
+                ", the fixed light"
+            } else {
+                ""
+            },
+            match self.surface {
+                SurfaceChoice::Matte => "",
+                SurfaceChoice::Varied => ", a varied surface",
+            },
             self.motion,
             match self.shading_refine {
                 0 => String::new(),

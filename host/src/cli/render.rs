@@ -9,7 +9,9 @@ use digiteyes_platform_linux::parse_frame_size;
 
 use crate::cli_values;
 use crate::render::Lighting;
-use crate::scenarios::{render_scenario, RenderOptions, DEFAULT_FRAMES, NAMES, RANDOM_NAMES};
+use crate::scenarios::{
+    render_scenario, RenderOptions, SurfaceChoice, DEFAULT_FRAMES, NAMES, RANDOM_NAMES,
+};
 
 /// Render a synthetic scenario to a sequence folder.
 ///
@@ -71,6 +73,11 @@ pub struct RenderArgs {
     /// 31° up-left of the camera's axis) instead of a random scenario's own.
     #[arg(long)]
     pub fixed_light: bool,
+    /// The hand's surface: `matte` (one grey, as the tracker's shading fit assumes) or
+    /// `varied` (each part its own grey, a glossy highlight, shadows the hand casts on
+    /// itself; drawn from the seed, the rig, motion and light left as they are).
+    #[arg(long, value_enum, default_value_t = SurfaceChoice::Matte)]
+    pub surface: SurfaceChoice,
     /// Image size in px, e.g. 320x240 (default 640x480); the view stays the same.
     #[arg(long, value_name = "WxH", value_parser = parse_frame_size)]
     pub size: Option<(u32, u32)>,
@@ -111,6 +118,7 @@ pub fn run(args: RenderArgs, progress: bool) -> Result<()> {
         blur: args.blur,
         clutter: args.clutter.then_some(true),
         lighting: args.fixed_light.then(Lighting::default),
+        surface: args.surface,
         size: args.size,
         supersample: args.supersample,
         progress,

@@ -15,8 +15,11 @@ pub mod intersect;
 pub mod lighting;
 pub mod scene;
 pub mod shapes;
+pub mod surface;
 
 use std::sync::Mutex;
+
+use intersect::Hit;
 
 use anyhow::Result;
 use digiteyes_core::camera::Camera;
@@ -28,6 +31,7 @@ pub use background::{Background, PLAIN_GREY};
 pub use lighting::{Lighting, ALBEDO, AMBIENT, LIGHT};
 pub use scene::Scene;
 pub use shapes::{world_shapes, WorldShape};
+pub use surface::Surface;
 
 /// How frames are rendered (besides the hand's state and the camera).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,6 +46,8 @@ pub struct RenderSettings {
     pub background: Background,
     /// How the hand is lit.
     pub lighting: Lighting,
+    /// What the hand's surface does with the light (matte and even by default).
+    pub surface: Surface,
     /// Worker threads; 0 uses every available core.
     pub threads: usize,
 }
@@ -54,6 +60,7 @@ impl Default for RenderSettings {
             blur_sigma: 0.0,
             background: Background::default(),
             lighting: Lighting::default(),
+            surface: Surface::default(),
             threads: 0,
         }
     }
@@ -144,12 +151,7 @@ impl Renderer {
             n => n,
         }
         .min(h.div_ceil(ROWS_PER_JOB));
-        let raster = Raster::new(
-            &self.camera,
-            self.settings.supersample,
-            self.settings.lighting,
-            mode,
-        );
+        let raster = Raster::new(&self.camera, &self.settings, mode);
         std::thread::scope(|s| {
             for _ in 0..threads {
                 s.spawn(|| {
@@ -179,14 +181,15 @@ struct Raster {
     /// Sub-pixel offsets of the rays along each axis (px).
     offsets: Vec<f64>,
     lighting: Lighting,
+    surface: Surface,
     /// Unit vector towards the light.
     light: Vector3<f64>,
     mode: Mode,
 }
 
 impl Raster {
-    fn new(camera: &Camera, supersample: u32, lighting: Lighting, mode: Mode) -> Self {
-        let n = supersample.max(1);
+    fn new(camera: &Camera, settings: &RenderSettings, mode: Mode) -> Self {
+        let n = settings.supersample.max(1);
         Raster {
             cx: f64::from(camera.cx),
             cy: f64::from(camera.cy),
@@ -195,10 +198,27 @@ impl Raster {
             offsets: (0..n)
                 .map(|i| (f64::from(i) + 0.5) / f64::from(n) - 0.5)
                 .collect(),
-            lighting,
-            light: lighting.unit_toward_light(),
+            lighting: settings.lighting,
+            surface: settings.surface,
+            light: settings.lighting.unit_toward_light(),
             mode,
         }
+    }
+
+    /// The grey level of the ray along unit `d` that hit part `part` of `scene` at `hit`.
+    fn shade(&self, scene: &Scene, d: &Vector3<f64>, part: usize, hit: &Hit) -> f64 {
+        let surface = &self.surface;
+        let facing = hit.normal.dot(&self.light);
+        let lit = facing > 0.0
+            && !(surface.cast_shadows
+                && scene.blocks(&Surface::shadow_origin(hit.t, d, &hit.normal), &self.light));
+        let albedo = self.lighting.albedo * surface.albedo_factor(part);
+        let ambient = self.lighting.ambient;
+        if !lit {
+            return albedo * ambient;
+        }
+        let highlight = surface.highlight(&hit.normal, d, &self.light);
+        albedo * (ambient + (1.0 - ambient) * facing + highlight)
     }
 
     /// Renders row `y` into `row`, which holds the background.
@@ -247,7 +267,7 @@ impl Raster {
                     let d = Vector3::new((u - self.cx) / self.fx, (v - self.cy) / self.fy, 1.0)
                         .normalize();
                     sum += match (scene.nearest(&d, candidates), self.mode) {
-                        (Some(hit), Mode::Shaded) => self.lighting.shade(&hit.normal, &self.light),
+                        (Some((part, hit)), Mode::Shaded) => self.shade(scene, &d, part, &hit),
                         (Some(_), Mode::Coverage) => 1.0,
                         (None, _) => behind,
                     };

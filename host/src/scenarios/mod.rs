@@ -22,7 +22,7 @@ use anyhow::{bail, ensure, Context, Result};
 use digiteyes_core::camera::Camera;
 use digiteyes_core::model::Model;
 
-use crate::render::{Background, Lighting, RenderSettings, Renderer};
+use crate::render::{Background, Lighting, RenderSettings, Renderer, Surface};
 use crate::sequence::{self, CameraFile, SequenceFile, BUILTIN_HAND};
 pub use catalogue::{scenario, Scenario, NAMES};
 pub use random::RANDOM_NAMES;
@@ -39,6 +39,18 @@ pub const VIEW_MARGIN_PX: f32 = 2.0;
 pub const SHRINK_STEP: f64 = 0.9;
 /// The smallest fraction of a scenario's amplitudes tried before giving up.
 pub const MIN_SHRINK: f64 = 0.5;
+
+/// The hand's surface in a rendered sequence (`--surface`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SurfaceChoice {
+    /// One matte grey under the light: what the tracker's shading fit assumes.
+    #[default]
+    Matte,
+    /// Each part its own grey, a glossy highlight, and the shadows the hand casts on itself,
+    /// drawn from the seed (`Surface::varied`).
+    Varied,
+}
 
 /// Options of [`render_scenario`]; `None` fields take the scenario's own setting.
 #[derive(Debug, Clone, PartialEq)]
@@ -58,6 +70,9 @@ pub struct RenderOptions {
     /// The hand's lighting; `None` for the scenario's own (drawn from the seed for the random
     /// scenarios, [`Lighting::default`] for the others).
     pub lighting: Option<Lighting>,
+    /// What the hand's surface does with the light: matte and even (the default), or drawn
+    /// from the seed ([`Surface::varied`]).
+    pub surface: SurfaceChoice,
     /// Image size (px); the intrinsics scale so the view is the same.
     pub size: Option<(u32, u32)>,
     /// Rays per pixel along each axis.
@@ -82,6 +97,7 @@ impl Default for RenderOptions {
             blur: None,
             clutter: None,
             lighting: None,
+            surface: SurfaceChoice::Matte,
             size: None,
             supersample: 3,
             progress: false,
@@ -205,6 +221,10 @@ pub fn generate_from(scenario: Scenario, opts: &RenderOptions) -> Result<Generat
             Background::default()
         },
         lighting: opts.lighting.unwrap_or(scenario.lighting),
+        surface: match opts.surface {
+            SurfaceChoice::Matte => Surface::default(),
+            SurfaceChoice::Varied => Surface::varied(opts.seed),
+        },
         threads: 0,
     };
     Ok(Generated {
