@@ -6,7 +6,7 @@
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::fingers::Fingers;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::likelihood::shading::{fit, fit_terms, residual_in, ShadingFit};
+use digiteyes_core::likelihood::shading::{fit, fit_terms, residual_in, PixelCost, ShadingFit};
 use digiteyes_core::nalgebra::Vector2;
 use digiteyes_core::projection::{Bounds, ProjectedModel};
 use digiteyes_core::silhouette::hand_bounds;
@@ -14,6 +14,8 @@ use digiteyes_host::scenarios::{generate, RenderOptions};
 use digiteyes_host::sequence::Sequence;
 
 mod common;
+
+use common::shading::scored;
 
 /// The lattice side the tests fit on.
 const GRID: usize = 64;
@@ -217,9 +219,20 @@ fn the_truths_fit_kept_leaves_less_over_the_hand_than_a_finger_bent_off() {
         let view = view_of(sequence, truth);
         let terms = fit(&view, camera, &frame, GRID).expect("a fit").terms;
         let hand = hand_bounds(&view).expect("the hand in view");
-        let at_truth = residual_in(&view, camera, &frame, &terms, &hand, 2.0).unwrap();
-        let off =
-            residual_in(&view_of(sequence, bent), camera, &frame, &terms, &hand, 2.0).unwrap();
+        let at_truth = residual_in(
+            &view,
+            camera,
+            &frame,
+            &scored(&terms, &hand, 2.0, PixelCost::SQUARE),
+        )
+        .unwrap();
+        let off = residual_in(
+            &view_of(sequence, bent),
+            camera,
+            &frame,
+            &scored(&terms, &hand, 2.0, PixelCost::SQUARE),
+        )
+        .unwrap();
         assert_eq!(off.points, at_truth.points, "the same pixels for both");
         off.sum_sq > at_truth.sum_sq
     });
@@ -238,7 +251,13 @@ fn a_region_with_no_hand_leaves_the_background_terms_residual_and_none_outside_t
         min: Vector2::new(10.5, 20.0),
         max: Vector2::new(50.0, 41.0),
     };
-    let found = residual_in(&empty, camera, &frame, &terms, &region, 3.0).unwrap();
+    let found = residual_in(
+        &empty,
+        camera,
+        &frame,
+        &scored(&terms, &region, 3.0, PixelCost::SQUARE),
+    )
+    .unwrap();
     let (mut sum_sq, mut points) = (0.0f64, 0u32);
     for j in 0..=7 {
         for i in 0..=13 {
@@ -260,7 +279,12 @@ fn a_region_with_no_hand_leaves_the_background_terms_residual_and_none_outside_t
         max: Vector2::new(500.0, 20.0),
     };
     assert_eq!(
-        residual_in(&empty, camera, &frame, &terms, &outside, 1.0),
+        residual_in(
+            &empty,
+            camera,
+            &frame,
+            &scored(&terms, &outside, 1.0, PixelCost::SQUARE)
+        ),
         None
     );
     // A step that is not a number is taken as one pixel.
@@ -268,6 +292,12 @@ fn a_region_with_no_hand_leaves_the_background_terms_residual_and_none_outside_t
         min: Vector2::new(10.0, 10.0),
         max: Vector2::new(12.0, 11.0),
     };
-    let r = residual_in(&empty, camera, &frame, &terms, &one_px, f32::NAN).unwrap();
+    let r = residual_in(
+        &empty,
+        camera,
+        &frame,
+        &scored(&terms, &one_px, f32::NAN, PixelCost::SQUARE),
+    )
+    .unwrap();
     assert_eq!(r.points, 6);
 }

@@ -347,41 +347,90 @@ fn solve(
     Some((normal.cholesky()?.solve(&rhs), points, on_hand))
 }
 
+/// How one pixel's residual counts toward a region's sum ([`residual_in`],
+/// [`super::shading_cache`]): its square, capped at `cap_grey²` when a cap is set — a
+/// truncated quadratic, so a highlight, a shadow or a part of another grey than the fit's
+/// (which the fit's one matte grey cannot model) costs no more than a pixel wholly wrong.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PixelCost {
+    /// The cap's square (grey levels²); 0 for none.
+    cap_sq: f32,
+}
+
+impl PixelCost {
+    /// Squares, uncapped.
+    pub const SQUARE: PixelCost = PixelCost { cap_sq: 0.0 };
+
+    /// Squares capped at `cap_grey²` (grey levels); squares alone when `cap_grey` is not a
+    /// positive finite number.
+    pub fn capped_at(cap_grey: f32) -> Self {
+        let cap_sq = cap_grey * cap_grey;
+        if cap_grey > 0.0 && cap_sq.is_finite() {
+            PixelCost { cap_sq }
+        } else {
+            PixelCost::SQUARE
+        }
+    }
+
+    /// The cost of residual `e` (grey levels): NaN stays NaN.
+    #[inline]
+    pub fn of(&self, e: f32) -> f32 {
+        let square = e * e;
+        if self.cap_sq > 0.0 && square > self.cap_sq {
+            self.cap_sq
+        } else {
+            square
+        }
+    }
+}
+
 /// The squared residual of a shading already fitted ([`ShadingFit::terms`]) over a region of
 /// the image: what a change confined there (one finger moved) does to the fit, without
 /// fitting again.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct RegionResidual {
-    /// Sum of squared residuals (grey levels²).
+    /// Sum of the pixels' costs ([`PixelCost`]; squared residuals, grey levels²).
     pub sum_sq: f32,
     /// Pixels sampled (inside the frame).
     pub points: u32,
 }
 
-/// The residual of `terms` (as [`fit`] found them, for this camera and frame) against the
-/// normals of `view` at every `step_px`-th pixel of `region` (px, clipped to the frame; the
-/// step at least 1 px). `None` when no pixel of the region lies in the frame, or the sum is
-/// not finite.
+/// How a region's shading residual is taken ([`residual_in`], [`super::shading_cache`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RegionScoring {
+    /// The fitted terms ([`ShadingFit::terms`]), for the camera and frame scored.
+    pub terms: [f32; TERMS],
+    /// The region (px; clipped to the frame).
+    pub region: Bounds,
+    /// Between the pixels sampled, along rows and columns (px; at least 1, 1 when not
+    /// finite).
+    pub step_px: f32,
+    /// How each pixel's residual counts.
+    pub cost: PixelCost,
+}
+
+/// The residual of `scoring`'s terms against the normals of `view` at its region's pixels.
+/// `None` when no pixel of the region lies in the frame, or the sum is not finite.
 pub fn residual_in(
     view: &ProjectedModel,
     camera: &Camera,
     frame: &FrameView<'_>,
-    terms: &[f32; TERMS],
-    region: &Bounds,
-    step_px: f32,
+    scoring: &RegionScoring,
 ) -> Option<RegionResidual> {
-    let lattice = RegionLattice::new(frame, region, step_px)?;
+    let lattice = RegionLattice::new(frame, &scoring.region, scoring.step_px)?;
     let capsules = capsules(view, camera);
     let capsules = &capsules[..view.links.len().min(MAX_LINKS)];
-    let terms = SVector::<f32, TERMS>::from_column_slice(terms);
+    let terms = SVector::<f32, TERMS>::from_column_slice(&scoring.terms);
     let (mut sum_sq, mut points) = (0.0f32, 0u32);
     for p in lattice.points() {
         let Some(g) = frame.sample(p.x, p.y) else {
             continue;
         };
         let e = row_of(normal_at(view, camera, capsules, &p)).dot(&terms) - g;
-        sum_sq += e * e;
+        sum_sq += scoring.cost.of(e);
         points += 1;
     }
     (points > 0 && sum_sq.is_finite()).then_some(RegionResidual { sum_sq, points })
@@ -437,5 +486,24 @@ impl RegionLattice {
                 )
             })
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::PixelCost;
+
+    #[test]
+    fn a_capped_cost_is_the_square_up_to_the_cap() {
+        let cost = PixelCost::capped_at(10.0);
+        assert_eq!(cost.of(3.0), 9.0);
+        assert_eq!(cost.of(-10.0), 100.0);
+        assert_eq!(cost.of(40.0), 100.0);
+        assert!(cost.of(f32::NAN).is_nan());
+        for no_cap in [0.0, -1.0, f32::NAN, f32::INFINITY, 1e30] {
+            assert_eq!(PixelCost::capped_at(no_cap), PixelCost::SQUARE);
+        }
+        assert_eq!(PixelCost::SQUARE.of(40.0), 1600.0);
+        assert_eq!(PixelCost::default(), PixelCost::SQUARE);
     }
 }

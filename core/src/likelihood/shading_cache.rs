@@ -11,7 +11,8 @@
 use nalgebra::{SVector, Vector3};
 
 use super::shading::{
-    capsules, link_hit, nearest_surface, row_of, unit_ray, RegionLattice, RegionResidual, TERMS,
+    capsules, link_hit, nearest_surface, row_of, unit_ray, RegionLattice, RegionResidual,
+    RegionScoring, TERMS,
 };
 use crate::camera::Camera;
 use crate::config::MAX_LINKS;
@@ -36,7 +37,8 @@ pub type MovingFrames = [bool; MAX_LINKS];
 /// One region pixel as the fixed part of the hand leaves it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct FixedPixel {
-    /// The square of the fit's prediction minus the frame's grey level there (grey levels²).
+    /// The cost ([`super::shading::PixelCost`]) of the fit's prediction minus the frame's grey level there
+    /// (grey levels²).
     residual_sq: f32,
     /// Camera depth of the nearest fixed surface (mm; infinite where none is hit, NaN where
     /// the pixel is not sampled).
@@ -70,6 +72,8 @@ impl Default for ShadingCache {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CachedRegion {
     lattice: RegionLattice,
+    /// How it is scored.
+    scoring: RegionScoring,
     /// Its first pixel in the cache.
     start: usize,
     /// The cache's generation when it was kept.
@@ -113,23 +117,20 @@ impl ShadingCache {
         self.generation = self.generation.wrapping_add(1);
     }
 
-    /// Keeps, for every `step_px`-th pixel of `region` (as [`super::shading::residual_in`]
-    /// clips it), the residual of `terms` against the nearest surface of `view` whose link
-    /// does not move with `moving` (or the palm), and that surface's depth. `None`, keeping
-    /// nothing, when no pixel of the region lies in the frame or its pixels do not fit in
-    /// what is left of [`MAX_CACHED_PIXELS`].
-    #[allow(clippy::too_many_arguments)] // one camera's view, frame and fit, and the region
+    /// Keeps, for every pixel of `scoring`'s region (as [`super::shading::residual_in`]
+    /// samples it), the cost of the residual of its terms against the nearest surface of
+    /// `view` whose link does not move with `moving` (or the palm), and that surface's depth.
+    /// `None`, keeping nothing, when no pixel of the region lies in the frame or its pixels do
+    /// not fit in what is left of [`MAX_CACHED_PIXELS`].
     pub fn fill(
         &mut self,
         view: &ProjectedModel,
         camera: &Camera,
         frame: &FrameView<'_>,
-        terms: &[f32; TERMS],
-        region: &Bounds,
-        step_px: f32,
+        scoring: &RegionScoring,
         moving: &MovingFrames,
     ) -> Option<CachedRegion> {
-        let lattice = RegionLattice::new(frame, region, step_px)?;
+        let lattice = RegionLattice::new(frame, &scoring.region, scoring.step_px)?;
         let start = self.used;
         let end = start.checked_add(lattice.len())?;
         if end > self.room {
@@ -137,7 +138,7 @@ impl ShadingCache {
         }
         let pixels = self.pixels.get_mut(start..end)?;
         let capsules = capsules(view, camera);
-        let terms = SVector::<f32, TERMS>::from_column_slice(terms);
+        let terms = SVector::<f32, TERMS>::from_column_slice(&scoring.terms);
         for (pixel, p) in pixels.iter_mut().zip(lattice.points()) {
             let Some(g) = frame.sample(p.x, p.y) else {
                 *pixel = UNSAMPLED;
@@ -148,30 +149,30 @@ impl ShadingCache {
             });
             let e = row_of(best.map(|(_, n)| n)).dot(&terms) - g;
             *pixel = FixedPixel {
-                residual_sq: e * e,
+                residual_sq: scoring.cost.of(e),
                 depth_mm: best.map_or(f32::INFINITY, |(z, _)| z),
             };
         }
         self.used = end;
         Some(CachedRegion {
             lattice,
+            scoring: *scoring,
             start,
             generation: self.generation,
         })
     }
 
-    /// The residual of `terms` over `cached` (kept by [`ShadingCache::fill`] for this camera,
-    /// frame and fit) with `view`'s links that move with `moving` where they are now: what
-    /// [`super::shading::residual_in`] gives for `view` when nothing else has moved since.
-    /// `None` when the region was not kept here, no pixel was sampled, or the sum is not
-    /// finite.
+    /// The residual over `cached` (kept by [`ShadingCache::fill`] for this camera and frame,
+    /// scored as it was kept) with `view`'s links that move with `moving` where they are now:
+    /// what [`super::shading::residual_in`] gives for `view` when nothing else has moved
+    /// since. `None` when the region was not kept here, no pixel was sampled, or the sum is
+    /// not finite.
     pub fn residual(
         &self,
         cached: &CachedRegion,
         view: &ProjectedModel,
         camera: &Camera,
         frame: &FrameView<'_>,
-        terms: &[f32; TERMS],
         moving: &MovingFrames,
     ) -> Option<RegionResidual> {
         let end = cached.start.checked_add(cached.lattice.len())?;
@@ -191,7 +192,7 @@ impl ShadingCache {
                 }));
             }
         }
-        let terms = SVector::<f32, TERMS>::from_column_slice(terms);
+        let terms = SVector::<f32, TERMS>::from_column_slice(&cached.scoring.terms);
         let (mut sum_sq, mut points) = (0.0f32, 0u32);
         for (pixel, p) in pixels.iter().zip(cached.lattice.points()) {
             if pixel.depth_mm.is_nan() {
@@ -219,10 +220,7 @@ impl ShadingCache {
                 }
             }
             let e_sq = match best.and_then(|(_, n)| Some((n, frame.sample(p.x, p.y)?))) {
-                Some((n, g)) => {
-                    let e = row_of(Some(n)).dot(&terms) - g;
-                    e * e
-                }
+                Some((n, g)) => cached.scoring.cost.of(row_of(Some(n)).dot(&terms) - g),
                 None => pixel.residual_sq,
             };
             sum_sq += e_sq;

@@ -15,7 +15,7 @@
 use heapless::Vec;
 use nalgebra::Vector2;
 
-use super::shading::{fit_terms, residual_in, RegionResidual};
+use super::shading::{fit_terms, residual_in, PixelCost, RegionResidual, RegionScoring};
 use super::shading_cache::{moving_frames, CachedRegion, ShadingCache};
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_STATES};
@@ -58,6 +58,10 @@ pub struct ShadingRefineConfig {
     /// (0.005 by default: on fresh seeds a finger then moves only where its shading clearly
     /// says so, and fewer tracks are lost to a move than with none; `docs/robustness.md`).
     pub margin: f32,
+    /// Each pixel's squared residual is capped at this many grey levels squared (0: no cap,
+    /// the default), so a highlight, a shadow or a part of another grey than the fit's counts
+    /// no more than a pixel wholly wrong ([`PixelCost`]).
+    pub residual_cap_grey: f32,
 }
 
 impl Default for ShadingRefineConfig {
@@ -72,6 +76,7 @@ impl Default for ShadingRefineConfig {
             curl: false,
             single_flexions: true,
             margin: 0.005,
+            residual_cap_grey: 0.0,
         }
     }
 }
@@ -93,8 +98,7 @@ pub struct RefineOutcome {
 /// surfaces when they fit the cache.
 #[derive(Clone, Copy)]
 struct StartFit {
-    terms: [f32; 5],
-    region: Bounds,
+    scoring: RegionScoring,
     cached: Option<CachedRegion>,
 }
 
@@ -143,15 +147,8 @@ pub fn refine_finger(
             };
             view.update(model, poses, camera, 0.0);
             let residual: Option<RegionResidual> = match &fit.cached {
-                Some(cached) => cache.residual(cached, view, camera, frame, &fit.terms, &moving),
-                None => residual_in(
-                    view,
-                    camera,
-                    frame,
-                    &fit.terms,
-                    &fit.region,
-                    config.region_step_px,
-                ),
+                Some(cached) => cache.residual(cached, view, camera, frame, &moving),
+                None => residual_in(view, camera, frame, &fit.scoring),
             };
             match residual {
                 Some(r) => sum += r.sum_sq,
@@ -258,24 +255,17 @@ fn start_fits(
                 min: a.min.inf(&b.min),
                 max: a.max.sup(&b.max),
             })?;
-        let region = Bounds {
-            min: bounds.min - pad,
-            max: bounds.max + pad,
-        };
-        let cached = cache.fill(
-            view,
-            camera,
-            frame,
-            &terms,
-            &region,
-            config.region_step_px,
-            moving,
-        );
-        *slot = Some(StartFit {
+        let scoring = RegionScoring {
             terms,
-            region,
-            cached,
-        });
+            region: Bounds {
+                min: bounds.min - pad,
+                max: bounds.max + pad,
+            },
+            step_px: config.region_step_px,
+            cost: PixelCost::capped_at(config.residual_cap_grey),
+        };
+        let cached = cache.fill(view, camera, frame, &scoring, moving);
+        *slot = Some(StartFit { scoring, cached });
     }
     Some(fits)
 }

@@ -4,6 +4,7 @@
 pub mod browser;
 pub mod frames;
 pub mod search;
+pub mod shading;
 
 use std::path::{Path, PathBuf};
 
