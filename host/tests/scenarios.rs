@@ -234,3 +234,24 @@ fn a_varied_surface_changes_the_hand_alone() {
         assert!(hand > 1000 && changed * 2 > hand, "{changed} of {hand}");
     }
 }
+
+#[test]
+fn each_single_effect_is_the_varied_surfaces_own() {
+    let seed = 9;
+    let varied = SurfaceChoice::Varied.surface(seed);
+    assert!(SurfaceChoice::Matte.surface(seed).is_matte());
+    let greys = SurfaceChoice::Greys.surface(seed);
+    let gloss = SurfaceChoice::Gloss.surface(seed);
+    let shadows = SurfaceChoice::Shadows.surface(seed);
+    for part in 0..16 {
+        assert_eq!(greys.albedo_factor(part), varied.albedo_factor(part));
+        assert_eq!(gloss.albedo_factor(part), 1.0);
+        assert_eq!(shadows.albedo_factor(part), 1.0);
+    }
+    assert_eq!(
+        (gloss.specular, gloss.shininess),
+        (varied.specular, varied.shininess)
+    );
+    assert_eq!((greys.specular, shadows.specular), (0.0, 0.0));
+    assert!(shadows.cast_shadows && !greys.cast_shadows && !gloss.cast_shadows);
+}

@@ -498,6 +498,9 @@ impl fmt::Display for Sweep {
             match self.surface {
                 SurfaceChoice::Matte => "",
                 SurfaceChoice::Varied => ", a varied surface",
+                SurfaceChoice::Greys => ", parts of their own greys",
+                SurfaceChoice::Gloss => ", a glossy surface",
+                SurfaceChoice::Shadows => ", cast shadows",
             },
             self.motion,
             match self.shading_refine {

@@ -50,6 +50,38 @@ pub enum SurfaceChoice {
     /// Each part its own grey, a glossy highlight, and the shadows the hand casts on itself,
     /// drawn from the seed (`Surface::varied`).
     Varied,
+    /// `varied`'s parts' greys alone.
+    Greys,
+    /// `varied`'s highlight alone.
+    Gloss,
+    /// `varied`'s cast shadows alone.
+    Shadows,
+}
+
+impl SurfaceChoice {
+    /// The surface this choice draws for seed `seed`.
+    pub fn surface(self, seed: u64) -> Surface {
+        let varied = Surface::varied(seed);
+        let matte = Surface::default();
+        match self {
+            SurfaceChoice::Matte => matte,
+            SurfaceChoice::Varied => varied,
+            SurfaceChoice::Greys => Surface {
+                albedo_spread: varied.albedo_spread,
+                seed: varied.seed,
+                ..matte
+            },
+            SurfaceChoice::Gloss => Surface {
+                specular: varied.specular,
+                shininess: varied.shininess,
+                ..matte
+            },
+            SurfaceChoice::Shadows => Surface {
+                cast_shadows: true,
+                ..matte
+            },
+        }
+    }
 }
 
 /// Options of [`render_scenario`]; `None` fields take the scenario's own setting.
@@ -221,10 +253,7 @@ pub fn generate_from(scenario: Scenario, opts: &RenderOptions) -> Result<Generat
             Background::default()
         },
         lighting: opts.lighting.unwrap_or(scenario.lighting),
-        surface: match opts.surface {
-            SurfaceChoice::Matte => Surface::default(),
-            SurfaceChoice::Varied => Surface::varied(opts.seed),
-        },
+        surface: opts.surface.surface(opts.seed),
         threads: 0,
     };
     Ok(Generated {
