@@ -6,9 +6,7 @@
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::fingers::Fingers;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::likelihood::shading::{
-    fit, fit_terms, fit_terms_within, residual_in, PixelCost, ShadingFit,
-};
+use digiteyes_core::likelihood::shading::{fit, fit_terms, residual_in, PixelCost, ShadingFit};
 use digiteyes_core::nalgebra::Vector2;
 use digiteyes_core::projection::{Bounds, ProjectedModel};
 use digiteyes_core::silhouette::hand_bounds;
@@ -140,20 +138,6 @@ fn the_fitted_light_points_where_the_renderer_lit_from() {
     angles.sort_by(f64::total_cmp);
     let median = angles[angles.len() / 2];
     assert!(median < 20.0, "median {median:.1}° ({angles:?})");
-}
-
-#[test]
-fn no_cap_fits_once_as_before() {
-    let dir = tempfile::tempdir().unwrap();
-    let sequence = common::seeded(dir.path(), "random-mono", 203, 1);
-    let truth = sequence.read_truth().unwrap();
-    let q: Vec<f32> = truth.rows[0].iter().map(|&v| v as f32).collect();
-    let (view, image) = (view_of(&sequence, &q), image_of(&sequence, 0));
-    let (camera, frame) = (&sequence.cameras[0], frame_of(&image));
-    let once = fit_terms(&view, camera, &frame, GRID);
-    assert!(once.is_some());
-    let again = fit_terms_within(&view, camera, &frame, GRID, PixelCost::SQUARE);
-    assert_eq!(again, once);
 }
 
 #[test]

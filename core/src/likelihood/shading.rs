@@ -233,7 +233,7 @@ pub fn fit(
     let lattice = FitLattice::over(view, grid)?;
     let capsules = capsules(view, camera);
     let capsules = &capsules[..view.links.len().min(MAX_LINKS)];
-    let (terms, points, on_hand) = solve(view, camera, frame, &lattice, capsules, |_, _| true)?;
+    let (terms, points, on_hand) = solve(view, camera, frame, &lattice, capsules)?;
     // The residual, in a second pass: exact in f32, where `gᵀg − tᵀAᵀg` would cancel.
     let mut sum = 0.0f32;
     for j in 0..lattice.grid {
@@ -264,42 +264,7 @@ pub fn fit_terms(
     let lattice = FitLattice::over(view, grid)?;
     let capsules = capsules(view, camera);
     let capsules = &capsules[..view.links.len().min(MAX_LINKS)];
-    let (terms, _, _) = solve(view, camera, frame, &lattice, capsules, |_, _| true)?;
-    finite_terms(&terms)
-}
-
-/// [`fit_terms`], then fitted again on the lattice points whose residual under those terms
-/// lies within `cost`'s cap (every point when it has none): a highlight, a shadow or a part
-/// of another grey than the rest then does not pull the fit. The first terms when too few
-/// points are left for a second fit; `None` as for [`fit_terms`].
-pub fn fit_terms_within(
-    view: &ProjectedModel,
-    camera: &Camera,
-    frame: &FrameView<'_>,
-    grid: usize,
-    cost: PixelCost,
-) -> Option<[f32; TERMS]> {
-    let lattice = FitLattice::over(view, grid)?;
-    let capsules = capsules(view, camera);
-    let capsules = &capsules[..view.links.len().min(MAX_LINKS)];
-    let (first, _, _) = solve(view, camera, frame, &lattice, capsules, |_, _| true)?;
-    let first = finite_terms(&first)?;
-    if cost == PixelCost::SQUARE {
-        return Some(first);
-    }
-    let within = |row: &SVector<f32, TERMS>, g: f32| {
-        cost.within(row.dot(&SVector::<f32, TERMS>::from_column_slice(&first)) - g)
-    };
-    let again = solve(view, camera, frame, &lattice, capsules, within);
-    Some(
-        again
-            .and_then(|(t, _, _)| finite_terms(&t))
-            .unwrap_or(first),
-    )
-}
-
-/// The terms as an array, when every one is finite.
-fn finite_terms(terms: &SVector<f32, TERMS>) -> Option<[f32; TERMS]> {
+    let (terms, _, _) = solve(view, camera, frame, &lattice, capsules)?;
     terms
         .iter()
         .all(|t| t.is_finite())
@@ -349,16 +314,14 @@ impl FitLattice {
     }
 }
 
-/// The least-squares terms over the points of `lattice` that `keep` takes (given each one's
-/// row and grey level), the points in the frame and those on the hand; `None` with too few of
-/// either or a singular system.
+/// The least-squares terms over `lattice`, the points in the frame and those on the hand;
+/// `None` with too few of either or a singular system.
 fn solve(
     view: &ProjectedModel,
     camera: &Camera,
     frame: &FrameView<'_>,
     lattice: &FitLattice,
     capsules: &[Capsule],
-    keep: impl Fn(&SVector<f32, TERMS>, f32) -> bool,
 ) -> Option<(SVector<f32, TERMS>, u16, u16)> {
     let mut normal = SMatrix::<f32, TERMS, TERMS>::zeros();
     let mut rhs = SVector::<f32, TERMS>::zeros();
@@ -368,9 +331,6 @@ fn solve(
             let Some((row, g)) = lattice.row_at(view, camera, capsules, frame, i, j) else {
                 continue;
             };
-            if !keep(&row, g) {
-                continue;
-            }
             normal += row * row.transpose();
             rhs += row * g;
             points += 1;
@@ -411,13 +371,6 @@ impl PixelCost {
         } else {
             PixelCost::SQUARE
         }
-    }
-
-    /// Whether residual `e` (grey levels) lies within the cap (any finite one without a cap).
-    #[inline]
-    pub fn within(&self, e: f32) -> bool {
-        let square = e * e;
-        square.is_finite() && (self.cap_sq == 0.0 || square <= self.cap_sq)
     }
 
     /// The cost of residual `e` (grey levels): NaN stays NaN.
@@ -552,7 +505,5 @@ mod tests {
         }
         assert_eq!(PixelCost::SQUARE.of(40.0), 1600.0);
         assert_eq!(PixelCost::default(), PixelCost::SQUARE);
-        assert!(cost.within(-10.0) && !cost.within(10.5) && !cost.within(f32::NAN));
-        assert!(PixelCost::SQUARE.within(1e6) && !PixelCost::SQUARE.within(f32::INFINITY));
     }
 }

@@ -15,7 +15,7 @@
 use heapless::Vec;
 use nalgebra::Vector2;
 
-use super::shading::{fit_terms_within, residual_in, PixelCost, RegionResidual, RegionScoring};
+use super::shading::{fit_terms, residual_in, PixelCost, RegionResidual, RegionScoring};
 use super::shading_cache::{moving_frames, CachedRegion, ShadingCache};
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_STATES};
@@ -62,9 +62,6 @@ pub struct ShadingRefineConfig {
     /// the default), so a highlight, a shadow or a part of another grey than the fit's counts
     /// no more than a pixel wholly wrong ([`PixelCost`]).
     pub residual_cap_grey: f32,
-    /// With a cap, fit the shading a second time on the lattice points within it
-    /// ([`super::shading::fit_terms_within`]; false by default).
-    pub refit_within_cap: bool,
 }
 
 impl Default for ShadingRefineConfig {
@@ -80,7 +77,6 @@ impl Default for ShadingRefineConfig {
             single_flexions: true,
             margin: 0.005,
             residual_cap_grey: 0.0,
-            refit_within_cap: false,
         }
     }
 }
@@ -249,13 +245,7 @@ fn start_fits(
     let mut fits: Fits = [None; MAX_CAMERAS];
     for ((camera, frame), slot) in cameras.iter().zip(frames).zip(fits.iter_mut()) {
         view.update(model, poses, camera, 0.0);
-        let cost = PixelCost::capped_at(config.residual_cap_grey);
-        let refit = if config.refit_within_cap {
-            cost
-        } else {
-            PixelCost::SQUARE
-        };
-        let terms = fit_terms_within(view, camera, frame, usize::from(config.grid), refit)?;
+        let terms = fit_terms(view, camera, frame, usize::from(config.grid))?;
         let bounds = view
             .links
             .iter()
@@ -272,7 +262,7 @@ fn start_fits(
                 max: bounds.max + pad,
             },
             step_px: config.region_step_px,
-            cost,
+            cost: PixelCost::capped_at(config.residual_cap_grey),
         };
         let cached = cache.fill(view, camera, frame, &scoring, moving);
         *slot = Some(StartFit { scoring, cached });

@@ -111,7 +111,6 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             }
             "shademargin" => c.shading_refine.margin = f,
             "shadecap" => c.shading_refine.residual_cap_grey = f,
-            "shaderefit" => c.shading_refine.refit_within_cap = f != 0.0,
             "lostrms" => c.lost_rms_px = f,
             "sdrop" => c.lost_silhouette_drop = f,
             "shold" => c.motion.hold_on_silhouette_drop = f != 0.0,

@@ -8,7 +8,6 @@ pub mod shading;
 
 use std::path::{Path, PathBuf};
 
-use digiteyes_host::scenarios::SurfaceChoice;
 use digiteyes_host::sequence::Sequence;
 use digiteyes_host::{render_scenario, RenderOptions};
 
@@ -28,23 +27,11 @@ pub fn mouse(dir: &Path, frames: usize) -> PathBuf {
 /// `scenario` rendered with `seed`, `frames` frames at 320×240, in `dir/{scenario}-{seed}`,
 /// opened (quick enough for debug builds).
 pub fn seeded(dir: &Path, scenario: &str, seed: u64, frames: usize) -> Sequence {
-    seeded_with(dir, scenario, seed, frames, SurfaceChoice::Matte)
-}
-
-/// [`seeded`], the hand drawn with `surface`.
-pub fn seeded_with(
-    dir: &Path,
-    scenario: &str,
-    seed: u64,
-    frames: usize,
-    surface: SurfaceChoice,
-) -> Sequence {
-    let seq = dir.join(format!("{scenario}-{seed}-{surface:?}"));
+    let seq = dir.join(format!("{scenario}-{seed}"));
     let options = RenderOptions {
         seed,
         frames: Some(frames),
         size: Some((320, 240)),
-        surface,
         ..RenderOptions::default()
     };
     render_scenario(scenario, &seq, &options).unwrap();
