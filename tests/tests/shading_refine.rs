@@ -146,9 +146,12 @@ fn the_tracker_refines_only_when_asked_and_refuses_a_wrong_frame() {
     let outcome = tracker.refine_shading(&[frame]).unwrap();
     assert_eq!(outcome.trials, 0);
     assert_eq!(tracker.memory(), before);
-    // Asked, from a finger bent off: it moves, and keeps the velocity.
+    // Asked, from a finger bent off: it moves, and keeps the velocity. With no margin, so
+    // that any try leaving less moves it (the default's 0.5 % over capped residuals holds
+    // this finger still; what the margin and the cap do is measured on the sweep).
     let mut config = TrackerConfig::default();
     config.shading_refine.every_frames = 1;
+    config.shading_refine.margin = 0.0;
     let mut tracker = sequence_tracker(&sequence, config).unwrap();
     tracker.track(&[frame]).unwrap();
     let mut memory = tracker.memory();
@@ -197,7 +200,7 @@ fn several_fingers_a_call_are_the_fingers_in_turn_one_after_another() {
             .filter(|&s| fingers.contains(f, s))
             .skip(1)
         {
-            memory.state[s] += 0.1;
+            memory.state[s] += 0.15;
         }
     }
     tracker.restore(&memory).unwrap();

@@ -58,9 +58,12 @@ pub struct ShadingRefineConfig {
     /// (0.005 by default: on fresh seeds a finger then moves only where its shading clearly
     /// says so, and fewer tracks are lost to a move than with none; `docs/robustness.md`).
     pub margin: f32,
-    /// Each pixel's squared residual is capped at this many grey levels squared (0: no cap,
-    /// the default), so a highlight, a shadow or a part of another grey than the fit's counts
-    /// no more than a pixel wholly wrong ([`PixelCost`]).
+    /// Each pixel's squared residual is capped at this many grey levels squared (0: no cap),
+    /// so a highlight, a shadow or a part of another grey than the fit's counts no more than
+    /// a pixel wholly wrong ([`PixelCost`]). 20 by default: on hands drawn with those
+    /// (`render --surface varied`) the refinement without a cap lost life, with it less or
+    /// none, and on the matte hands it kept its gain (`docs/robustness.md`, "A surface the
+    /// shading fit does not model").
     pub residual_cap_grey: f32,
 }
 
@@ -76,7 +79,7 @@ impl Default for ShadingRefineConfig {
             curl: false,
             single_flexions: true,
             margin: 0.005,
-            residual_cap_grey: 0.0,
+            residual_cap_grey: 20.0,
         }
     }
 }

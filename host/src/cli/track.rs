@@ -64,8 +64,10 @@ pub struct TrackArgs {
     #[arg(long)]
     pub no_predict: bool,
     /// After every N-th frame tracked, move one finger in turn where the hand's shading
-    /// says it lies (0: never, the default). Costs up to 20 residuals over a finger a frame;
-    /// docs/robustness.md, "The shading pulls a finger back".
+    /// says it lies (0: never, the default). Costs up to 16 residuals over a finger a frame.
+    /// It models the hand as one matte grey: on glossy, shadowed hands of uneven grey it
+    /// helped two cameras a little and one camera not at all; docs/robustness.md, "The
+    /// shading pulls a finger back" and "A surface the shading fit does not model".
     #[arg(long, value_name = "N")]
     pub shading_refine: Option<u8>,
     /// No progress bar.
