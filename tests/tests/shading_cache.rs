@@ -6,7 +6,7 @@
 
 use digiteyes_core::hypotheses::fingers::Fingers;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::likelihood::shading::{fit, residual_in, PixelCost};
+use digiteyes_core::likelihood::shading::{fit, residual_in, PixelCost, RegionScoring};
 use digiteyes_core::likelihood::shading_cache::{moving_frames, ShadingCache, MAX_CACHED_PIXELS};
 use digiteyes_core::likelihood::shading_refine::{refine_finger, ShadingRefineConfig};
 use digiteyes_core::nalgebra::Vector2;
@@ -81,7 +81,11 @@ fn the_cache_gives_the_slow_sums_pixel_for_pixel() {
                         } else {
                             PixelCost::capped_at(30.0)
                         };
-                        let scoring = scored(&found.terms, &region, 2.0, cost);
+                        // The light's term clamped on fingers 2 and 3: the same sums too.
+                        let scoring = RegionScoring {
+                            clamp_light: (2..4).contains(&f),
+                            ..scored(&found.terms, &region, 2.0, cost)
+                        };
                         let mut cache = ShadingCache::default();
                         let kept = cache
                             .fill(&start, camera, frame, &scoring, &moving)

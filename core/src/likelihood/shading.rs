@@ -410,6 +410,28 @@ pub struct RegionScoring {
     pub step_px: f32,
     /// How each pixel's residual counts.
     pub cost: PixelCost,
+    /// Predict a surface facing away from the light at the hand grey alone (`m`, the light's
+    /// term clamped at 0, as a Lambertian surface is lit) instead of the linear fit's
+    /// `m + l · n` below it.
+    pub clamp_light: bool,
+}
+
+impl RegionScoring {
+    /// The grey level predicted where the nearest surface has unit normal `normal` (camera
+    /// coordinates; `None` off the hand), `terms` being [`RegionScoring::terms`] as a vector.
+    #[inline]
+    pub(super) fn predicted(
+        &self,
+        terms: &SVector<f32, TERMS>,
+        normal: Option<Vector3<f32>>,
+    ) -> f32 {
+        match normal {
+            Some(n) if self.clamp_light => {
+                terms[1] + (n.x * terms[2] + n.y * terms[3] + n.z * terms[4]).max(0.0)
+            }
+            normal => row_of(normal).dot(terms),
+        }
+    }
 }
 
 /// The residual of `scoring`'s terms against the normals of `view` at its region's pixels.
@@ -429,7 +451,7 @@ pub fn residual_in(
         let Some(g) = frame.sample(p.x, p.y) else {
             continue;
         };
-        let e = row_of(normal_at(view, camera, capsules, &p)).dot(&terms) - g;
+        let e = scoring.predicted(&terms, normal_at(view, camera, capsules, &p)) - g;
         sum_sq += scoring.cost.of(e);
         points += 1;
     }

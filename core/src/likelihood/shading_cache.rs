@@ -11,8 +11,8 @@
 use nalgebra::{SVector, Vector3};
 
 use super::shading::{
-    capsules, link_hit, nearest_surface, row_of, unit_ray, RegionLattice, RegionResidual,
-    RegionScoring, TERMS,
+    capsules, link_hit, nearest_surface, unit_ray, RegionLattice, RegionResidual, RegionScoring,
+    TERMS,
 };
 use crate::camera::Camera;
 use crate::config::MAX_LINKS;
@@ -147,7 +147,7 @@ impl ShadingCache {
             let best = nearest_surface(view, camera, &capsules, &p, |link| {
                 link_moves(moving, link.frame, link.child)
             });
-            let e = row_of(best.map(|(_, n)| n)).dot(&terms) - g;
+            let e = scoring.predicted(&terms, best.map(|(_, n)| n)) - g;
             *pixel = FixedPixel {
                 residual_sq: scoring.cost.of(e),
                 depth_mm: best.map_or(f32::INFINITY, |(z, _)| z),
@@ -220,7 +220,10 @@ impl ShadingCache {
                 }
             }
             let e_sq = match best.and_then(|(_, n)| Some((n, frame.sample(p.x, p.y)?))) {
-                Some((n, g)) => cached.scoring.cost.of(row_of(Some(n)).dot(&terms) - g),
+                Some((n, g)) => {
+                    let scoring = &cached.scoring;
+                    scoring.cost.of(scoring.predicted(&terms, Some(n)) - g)
+                }
                 None => pixel.residual_sq,
             };
             sum_sq += e_sq;

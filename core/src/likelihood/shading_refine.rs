@@ -65,6 +65,9 @@ pub struct ShadingRefineConfig {
     /// none, and on the matte hands it kept its gain (`docs/robustness.md`, "A surface the
     /// shading fit does not model").
     pub residual_cap_grey: f32,
+    /// Predict a surface facing away from the fitted light at the hand grey alone, as a
+    /// Lambertian surface is lit ([`RegionScoring::clamp_light`]; false by default).
+    pub clamp_light: bool,
 }
 
 impl Default for ShadingRefineConfig {
@@ -80,6 +83,7 @@ impl Default for ShadingRefineConfig {
             single_flexions: true,
             margin: 0.005,
             residual_cap_grey: 20.0,
+            clamp_light: false,
         }
     }
 }
@@ -266,6 +270,7 @@ fn start_fits(
             },
             step_px: config.region_step_px,
             cost: PixelCost::capped_at(config.residual_cap_grey),
+            clamp_light: config.clamp_light,
         };
         let cached = cache.fill(view, camera, frame, &scoring, moving);
         *slot = Some(StartFit { scoring, cached });

@@ -111,6 +111,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             }
             "shademargin" => c.shading_refine.margin = f,
             "shadecap" => c.shading_refine.residual_cap_grey = f,
+            "shadeclamp" => c.shading_refine.clamp_light = f != 0.0,
             "lostrms" => c.lost_rms_px = f,
             "sdrop" => c.lost_silhouette_drop = f,
             "shold" => c.motion.hold_on_silhouette_drop = f != 0.0,

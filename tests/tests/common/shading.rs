@@ -10,5 +10,6 @@ pub fn scored(terms: &[f32; 5], region: &Bounds, step_px: f32, cost: PixelCost) 
         region: *region,
         step_px,
         cost,
+        clamp_light: false,
     }
 }
