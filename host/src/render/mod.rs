@@ -2,7 +2,8 @@
 //!
 //! Every pixel is ray-cast against the capsules of the `cyl` links and the palm box (exact
 //! occlusion: the nearest hit wins), shaded Lambertian with a light near the camera plus
-//! ambient ([`Lighting`]), over a dark or cluttered background. Each pixel averages `supersample ×
+//! ambient ([`Lighting`]) — one matte grey unless a [`Surface`] gives the parts their own
+//! greys, a highlight and cast shadows — over a dark or cluttered background. Each pixel averages `supersample ×
 //! supersample` rays spread evenly over its square (pixel `(x, y)` covers `u ∈ [x − ½, x + ½]`,
 //! `v ∈ [y − ½, y + ½]`), so silhouettes are sub-pixel accurate. Optional Gaussian blur and
 //! noise follow. Rays are cast only inside each primitive's projected bounding rectangle, and
@@ -23,6 +24,7 @@ use intersect::Hit;
 
 use anyhow::Result;
 use digiteyes_core::camera::Camera;
+use digiteyes_core::config::MAX_LINKS;
 use digiteyes_core::model::Model;
 use image::GrayImage;
 use nalgebra::Vector3;
@@ -182,6 +184,8 @@ struct Raster {
     offsets: Vec<f64>,
     lighting: Lighting,
     surface: Surface,
+    /// Each part's albedo factor ([`Surface::albedo_factor`]), by part.
+    albedo_factors: Vec<f64>,
     /// Unit vector towards the light.
     light: Vector3<f64>,
     mode: Mode,
@@ -200,6 +204,9 @@ impl Raster {
                 .collect(),
             lighting: settings.lighting,
             surface: settings.surface,
+            albedo_factors: (0..=MAX_LINKS)
+                .map(|part| settings.surface.albedo_factor(part))
+                .collect(),
             light: settings.lighting.unit_toward_light(),
             mode,
         }
@@ -212,7 +219,8 @@ impl Raster {
         let lit = facing > 0.0
             && !(surface.cast_shadows
                 && scene.blocks(&Surface::shadow_origin(hit.t, d, &hit.normal), &self.light));
-        let albedo = self.lighting.albedo * surface.albedo_factor(part);
+        let factor = self.albedo_factors.get(part).copied();
+        let albedo = self.lighting.albedo * factor.unwrap_or_else(|| surface.albedo_factor(part));
         let ambient = self.lighting.ambient;
         if !lit {
             return albedo * ambient;
