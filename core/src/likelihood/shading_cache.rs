@@ -37,16 +37,16 @@ pub type MovingFrames = [bool; MAX_LINKS];
 /// One region pixel as the fixed part of the hand leaves it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct FixedPixel {
-    /// The cost ([`super::shading::PixelCost`]) of the fit's prediction minus the frame's grey level there
-    /// (grey levels²).
-    residual_sq: f32,
+    /// The cost ([`super::shading::PixelCost`]) of the fit's prediction minus the frame's
+    /// grey level there (grey levels²).
+    cost: f32,
     /// Camera depth of the nearest fixed surface (mm; infinite where none is hit, NaN where
     /// the pixel is not sampled).
     depth_mm: f32,
 }
 
 const UNSAMPLED: FixedPixel = FixedPixel {
-    residual_sq: 0.0,
+    cost: 0.0,
     depth_mm: f32::NAN,
 };
 
@@ -149,7 +149,7 @@ impl ShadingCache {
             });
             let e = scoring.predicted(&terms, best.map(|(_, n)| n)) - g;
             *pixel = FixedPixel {
-                residual_sq: scoring.cost.of(e),
+                cost: scoring.cost.of(e),
                 depth_mm: best.map_or(f32::INFINITY, |(z, _)| z),
             };
         }
@@ -200,7 +200,7 @@ impl ShadingCache {
             }
             points += 1;
             if !reach.is_some_and(|r| r.contains(&p)) {
-                sum_sq += pixel.residual_sq;
+                sum_sq += pixel.cost;
                 continue;
             }
             let mut ray = None;
@@ -224,7 +224,7 @@ impl ShadingCache {
                     let scoring = &cached.scoring;
                     scoring.cost.of(scoring.predicted(&terms, Some(n)) - g)
                 }
-                None => pixel.residual_sq,
+                None => pixel.cost,
             };
             sum_sq += e_sq;
         }

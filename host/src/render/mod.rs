@@ -3,11 +3,11 @@
 //! Every pixel is ray-cast against the capsules of the `cyl` links and the palm box (exact
 //! occlusion: the nearest hit wins), shaded Lambertian with a light near the camera plus
 //! ambient ([`Lighting`]) — one matte grey unless a [`Surface`] gives the parts their own
-//! greys, a highlight and cast shadows — over a dark or cluttered background. Each pixel averages `supersample ×
-//! supersample` rays spread evenly over its square (pixel `(x, y)` covers `u ∈ [x − ½, x + ½]`,
-//! `v ∈ [y − ½, y + ½]`), so silhouettes are sub-pixel accurate. Optional Gaussian blur and
-//! noise follow. Rays are cast only inside each primitive's projected bounding rectangle, and
-//! rows are shared among threads.
+//! greys, a highlight and cast shadows — over a dark or cluttered background. Each pixel
+//! averages `supersample × supersample` rays spread evenly over its square (pixel `(x, y)`
+//! covers `u ∈ [x − ½, x + ½]`, `v ∈ [y − ½, y + ½]`), so silhouettes are sub-pixel accurate.
+//! Optional Gaussian blur and noise follow. Rays are cast only inside each primitive's
+//! projected bounding rectangle, and rows are shared among threads.
 
 pub mod background;
 pub mod filter;
