@@ -219,20 +219,9 @@ fn the_truths_fit_kept_leaves_less_over_the_hand_than_a_finger_bent_off() {
         let view = view_of(sequence, truth);
         let terms = fit(&view, camera, &frame, GRID).expect("a fit").terms;
         let hand = hand_bounds(&view).expect("the hand in view");
-        let at_truth = residual_in(
-            &view,
-            camera,
-            &frame,
-            &scored(&terms, &hand, 2.0, PixelCost::SQUARE),
-        )
-        .unwrap();
-        let off = residual_in(
-            &view_of(sequence, bent),
-            camera,
-            &frame,
-            &scored(&terms, &hand, 2.0, PixelCost::SQUARE),
-        )
-        .unwrap();
+        let scoring = scored(&terms, &hand, 2.0, PixelCost::SQUARE);
+        let at_truth = residual_in(&view, camera, &frame, &scoring).unwrap();
+        let off = residual_in(&view_of(sequence, bent), camera, &frame, &scoring).unwrap();
         assert_eq!(off.points, at_truth.points, "the same pixels for both");
         off.sum_sq > at_truth.sum_sq
     });
@@ -251,13 +240,9 @@ fn a_region_with_no_hand_leaves_the_background_terms_residual_and_none_outside_t
         min: Vector2::new(10.5, 20.0),
         max: Vector2::new(50.0, 41.0),
     };
-    let found = residual_in(
-        &empty,
-        camera,
-        &frame,
-        &scored(&terms, &region, 3.0, PixelCost::SQUARE),
-    )
-    .unwrap();
+    let squares =
+        |region: &Bounds, step_px: f32| scored(&terms, region, step_px, PixelCost::SQUARE);
+    let found = residual_in(&empty, camera, &frame, &squares(&region, 3.0)).unwrap();
     let (mut sum_sq, mut points) = (0.0f64, 0u32);
     for j in 0..=7 {
         for i in 0..=13 {
@@ -279,12 +264,7 @@ fn a_region_with_no_hand_leaves_the_background_terms_residual_and_none_outside_t
         max: Vector2::new(500.0, 20.0),
     };
     assert_eq!(
-        residual_in(
-            &empty,
-            camera,
-            &frame,
-            &scored(&terms, &outside, 1.0, PixelCost::SQUARE)
-        ),
+        residual_in(&empty, camera, &frame, &squares(&outside, 1.0)),
         None
     );
     // A step that is not a number is taken as one pixel.
@@ -292,12 +272,6 @@ fn a_region_with_no_hand_leaves_the_background_terms_residual_and_none_outside_t
         min: Vector2::new(10.0, 10.0),
         max: Vector2::new(12.0, 11.0),
     };
-    let r = residual_in(
-        &empty,
-        camera,
-        &frame,
-        &scored(&terms, &one_px, f32::NAN, PixelCost::SQUARE),
-    )
-    .unwrap();
+    let r = residual_in(&empty, camera, &frame, &squares(&one_px, f32::NAN)).unwrap();
     assert_eq!(r.points, 6);
 }
