@@ -399,7 +399,6 @@ pub struct RegionResidual {
 
 /// How a region's shading residual is taken ([`residual_in`], [`super::shading_cache`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct RegionScoring {
     /// The fitted terms ([`ShadingFit::terms`]), for the camera and frame scored.
     pub terms: [f32; TERMS],
