@@ -28,6 +28,12 @@ pub const TRULY_LOST_PALM_MM: f64 = 30.0;
 /// confident answer that is nowhere near the hand.
 pub const FAR_PALM_MM: f64 = 100.0;
 
+/// The hand's surface the sweep draws unless asked otherwise: each part its own grey, glossy,
+/// casting shadows on itself (stop 67). A matte hand of one grey is what the tracker's shading
+/// fit assumes, so a sweep of matte hands flatters it (`docs/robustness.md`, "A surface the
+/// shading fit does not model").
+pub const SWEEP_SURFACE: SurfaceChoice = SurfaceChoice::Varied;
+
 /// The tracker configurations the benchmark compares.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize)]
 pub enum Motion {
@@ -95,11 +101,11 @@ pub struct RobustnessArgs {
     /// measured under it.
     #[arg(long)]
     pub fixed_light: bool,
-    /// The hand's surface in every seed: `matte` (one grey, as the tracker's shading fit
-    /// assumes; the sweep's figures in docs/robustness.md) or `varied` (each part its own
-    /// grey, a glossy highlight, shadows the hand casts on itself; drawn from each seed,
-    /// which keeps its rig, motion and light).
-    #[arg(long, value_enum, default_value_t = SurfaceChoice::Matte)]
+    /// The hand's surface in every seed: `varied` (the default since stop 67: each part its
+    /// own grey, a glossy highlight, shadows the hand casts on itself; drawn from each seed,
+    /// which keeps its rig, motion and light) or `matte` (one even grey, as the tracker's
+    /// shading fit assumes; the surface of docs/robustness.md's figures up to stop 66).
+    #[arg(long, value_enum, default_value_t = SWEEP_SURFACE)]
     pub surface: SurfaceChoice,
     /// After every N-th frame tracked, move one finger in turn where the hand's shading says
     /// it lies, as `track --shading-refine N` (0: never, the default).
@@ -496,7 +502,7 @@ impl fmt::Display for Sweep {
                 ""
             },
             match self.surface {
-                SurfaceChoice::Matte => "",
+                SurfaceChoice::Matte => ", a matte surface",
                 SurfaceChoice::Varied => ", a varied surface",
                 SurfaceChoice::Greys => ", parts of their own greys",
                 SurfaceChoice::Gloss => ", a glossy surface",

@@ -75,7 +75,8 @@ pub struct RenderArgs {
     pub fixed_light: bool,
     /// The hand's surface: `matte` (one grey, as the tracker's shading fit assumes) or
     /// `varied` (each part its own grey, a glossy highlight, shadows the hand casts on
-    /// itself; drawn from the seed, the rig, motion and light left as they are).
+    /// itself; drawn from the seed, the rig, motion and light left as they are). `bench
+    /// robustness` draws `varied`: give it here to render one of its seeds as it tracked it.
     #[arg(long, value_enum, default_value_t = SurfaceChoice::Matte)]
     pub surface: SurfaceChoice,
     /// Image size in px, e.g. 320x240 (default 640x480); the view stays the same.
