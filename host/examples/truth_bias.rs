@@ -18,7 +18,9 @@
 //!   fingertip's error there (which fingers are lost).
 //!
 //! Errors are mean fingertip reprojection errors (px) over the tips and cameras, as `eval`
-//! has them.
+//! has them. Each seed's line also gives the palm's error along camera 0's optical axis (mm,
+//! + away from the camera): with one camera the depth its image shows only through the
+//! hand's size (`docs/robustness.md`, "The sweep on the varied surface").
 //!
 //! ```text
 //! digiteyes bench robustness --seeds 60 --frames 200 --keep /tmp/keep
@@ -38,6 +40,7 @@ use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::{Shape, BASE_STATES};
 use digiteyes_core::motion::PriorWeights;
+use digiteyes_core::state::TRANSLATION;
 use digiteyes_core::tracker::Tracker;
 use digiteyes_host::eval::{compare, reprojection_error, stats, track_life, LOST_ERROR_PX};
 use digiteyes_host::sequence::{read_states, Sequence};
@@ -163,6 +166,16 @@ fn start_at(
     Ok(())
 }
 
+/// How far `estimate`'s palm lies beyond `truth`'s along camera 0's optical axis (mm): the
+/// depth one camera sees only through the hand's size in its image.
+fn palm_along_ray_mm(seed: &Seed, truth: &[f32], estimate: &[f32]) -> f64 {
+    let axis = seed.sequence.cameras[0].r.row(2);
+    TRANSLATION
+        .enumerate()
+        .map(|(i, s)| f64::from(axis[i]) * f64::from(estimate[s] - truth[s]))
+        .sum()
+}
+
 /// The angle between the palm rotations of two states (deg): quaternion states 0..4.
 fn palm_turn_deg(a: &[f32], b: &[f32]) -> f64 {
     let dot: f64 = (0..4).map(|i| f64::from(a[i]) * f64::from(b[i])).sum();
@@ -200,6 +213,8 @@ fn main() -> Result<()> {
     let mut all_passes = Vec::new();
     // Settle runs whose error grew over 3×: how far the palm turned (deg).
     let mut grown_turns = Vec::new();
+    // Every tracked frame's palm error along camera 0's optical axis (mm, + away from it).
+    let mut all_along_ray = Vec::new();
     for dir in dirs {
         let Some(seed) = open(&dir)? else { continue };
         if args.parity.is_some_and(|p| seed.number % 2 != p) {
@@ -236,6 +251,7 @@ fn main() -> Result<()> {
             start_at(&mut tracker, &seed.truth[1], None)?;
         }
         let mut errors = Vec::new();
+        let mut along_ray = Vec::new();
         for k in (2..seed.truth.len()).step_by(step) {
             let (t0, t1) = (&seed.truth[k - 1], &seed.truth[k]);
             match args.start.as_str() {
@@ -336,17 +352,22 @@ fn main() -> Result<()> {
             }
             track_frame(&mut tracker, &seed, k)?;
             errors.push(tip_error(&seed, k, tracker.state())?);
+            along_ray.push(palm_along_ray_mm(&seed, t1, tracker.state()));
         }
         let over = errors.iter().filter(|&&e| e > LOST_ERROR_PX).count() as f64;
         println!(
-            "seed {} cams {cams} median {:.1} p90 {:.1} max {:.1} over {LOST_ERROR_PX} px {:.2} life {:.2}",
+            "seed {} cams {cams} median {:.1} p90 {:.1} max {:.1} over {LOST_ERROR_PX} px {:.2} life {:.2}; palm along camera 0's ray median {:+.1} mm, p10 {:+.1}, p90 {:+.1}",
             seed.number,
             stats::percentile(&errors, 0.5),
             stats::percentile(&errors, 0.9),
             stats::percentile(&errors, 1.0),
             over / errors.len().max(1) as f64,
-            track_life(&errors)
+            track_life(&errors),
+            stats::percentile(&along_ray, 0.5),
+            stats::percentile(&along_ray, 0.1),
+            stats::percentile(&along_ray, 0.9),
         );
+        all_along_ray.extend(along_ray);
         all.extend(errors);
     }
     if args.start == "census" {
@@ -367,6 +388,11 @@ fn main() -> Result<()> {
         over / all.len().max(1) as f64
     );
     print_spread("after all passes / before:", &all_passes, "");
+    print_spread(
+        "palm along camera 0's ray (mm, + away from it):",
+        &all_along_ray,
+        "",
+    );
     print_spread(
         &format!(
             "runs grown over 3x: {}; palm turned (deg)",
