@@ -19,8 +19,8 @@
 //!
 //! Errors are mean fingertip reprojection errors (px) over the tips and cameras, as `eval`
 //! has them. Each seed's line also gives the palm's error along camera 0's optical axis (mm,
-//! + away from the camera): with one camera the depth its image shows only through the
-//! hand's size (`docs/robustness.md`, "The sweep on the varied surface").
+//! positive away from the camera): with one camera the depth its image shows only through
+//! the hand's size (`docs/robustness.md`, "The sweep on the varied surface").
 //!
 //! ```text
 //! digiteyes bench robustness --seeds 60 --frames 200 --keep /tmp/keep
