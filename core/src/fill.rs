@@ -14,7 +14,8 @@
 //! - a dark sample a link covers belongs to the link that covers it most deeply: its row
 //!   pulls the outline in past it;
 //! - a sample near the midpoint ([`FillConfig::class_margin`]) is neither: the hand's own
-//!   shaded side is not background.
+//!   shaded side is not background; nor is a dark sample in a link's core unless it is
+//!   darker still ([`FillConfig::core_share`]): a shadow on a finger is the hand's.
 //!
 //! Each row moves the outline where it is nearest the sample, a side or an end
 //! ([`region_row`](crate::estimator::region_row)); the palm's samples are left to its outline
@@ -82,6 +83,18 @@ pub struct FillConfig {
     /// at full weight). Default 1: a finger seen end-on is the thesis' singular
     /// configuration, whose outline says little of how its bend is split among its joints.
     pub full_length_widths: f32,
+    /// A dark sample in a link's core, nearer its axis than this share of its radius, is
+    /// classed dark only when it lies [`FillConfig::core_margin`] of the contrast below the
+    /// midpoint, not [`FillConfig::class_margin`] (0: every dark sample by the class margin,
+    /// as before). Where the hand shades itself (a shadow another part casts on a finger, a
+    /// part darker than the rest) the samples in a link's core are the hand's own, and rows
+    /// pulling its outline in past them read the hand smaller, so, with one camera, farther;
+    /// background in a link's core means the link is off its finger by most of its width,
+    /// and is darker. Default 0.7 (`docs/robustness.md`, "The sweep on the varied surface").
+    pub core_share: f32,
+    /// The class margin of a dark sample in a link's core ([`FillConfig::core_share`]), as a
+    /// share of the contrast. Default 0.4: no brighter than the uncovered mean plus 0.1 of it.
+    pub core_margin: f32,
 }
 
 impl Default for FillConfig {
@@ -93,6 +106,8 @@ impl Default for FillConfig {
             gather_iterations: 1,
             class_margin: 0.3,
             full_length_widths: 1.0,
+            core_share: 0.7,
+            core_margin: 0.4,
         }
     }
 }
@@ -106,6 +121,8 @@ impl FillConfig {
         gather_iterations: 1,
         class_margin: 0.3,
         full_length_widths: 1.0,
+        core_share: 0.7,
+        core_margin: 0.4,
     };
 
     /// Whether region rows are added.
@@ -214,6 +231,28 @@ fn cover_class(view: &ProjectedModel, camera: &Camera, among: &[u8], p: &Vector2
     best.0
 }
 
+/// How far below the class midpoint (grey levels) a dark sample at `p`, covered by link
+/// `index` of `view`, must lie to be classed dark: [`FillConfig::core_margin`] of the contrast
+/// in the link's core ([`FillConfig::core_share`] of its radius), 0 elsewhere (the class
+/// margin has already been passed).
+fn core_bar(
+    view: &ProjectedModel,
+    index: usize,
+    p: &Vector2<f32>,
+    config: &FillConfig,
+    contrast: f32,
+) -> f32 {
+    let Some(link) = view.links.get(index) else {
+        return 0.0;
+    };
+    let (s, dist) = link.closest(p);
+    if dist < config.core_share * link.radius_at(s) {
+        config.core_margin.max(0.0) * contrast
+    } else {
+        0.0
+    }
+}
+
 /// The links of `view` whose bounds span image row `y` (px), in order: every link whose
 /// bounds contain a point of that row is among them.
 fn links_across(view: &ProjectedModel, y: f32) -> Vec<u8, MAX_LINKS> {
@@ -316,7 +355,8 @@ pub fn gather(
             let link = match (c, bright) {
                 (UNCOVERED, true) => nearest_outline(view, &p, reach),
                 (OFF_FRAME | PALM | UNCOVERED, _) | (_, true) => None,
-                (_, false) => Some(usize::from(c)),
+                (_, false) => Some(usize::from(c))
+                    .filter(|&index| threshold - v >= core_bar(view, index, &p, config, contrast)),
             };
             if let Some(link) = link.and_then(|index| view.links.get(index)) {
                 out.push(FillSample {

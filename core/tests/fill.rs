@@ -1,6 +1,7 @@
 //! The region samples (`fill::gather`) on a frame painted from the model's own silhouette:
 //! none where the model lies on its image, many where it has moved off, each assigned to a
-//! link that exists, and a gather that pulls the moved hand back.
+//! link that exists, and a gather that pulls the moved hand back; the hand's own shade, on its
+//! shaded side or in a link's core, is not classed as background.
 
 use digiteyes_core::camera::Camera;
 use digiteyes_core::fill::{gather, FillConfig, FillPoints, MAX_FILL_POINTS};
@@ -131,6 +132,7 @@ fn the_hands_own_shade_is_not_background() {
     let at_truth = view_at(&model, &truth, &camera);
     let midpoint = FillConfig {
         class_margin: 0.0,
+        core_share: 0.0,
         ..FillConfig::default()
     };
     gather(&at_truth, &camera, &frame, &midpoint, &mut out);
@@ -181,4 +183,93 @@ fn a_foreshortened_links_rows_are_weighed_down_by_length_over_width() {
         ..config
     };
     assert_eq!(every_link.link_weight(&link), config.weight);
+}
+
+/// Whether pixel `i` of a frame `w` wide lies in the core of a link of `view`: within half
+/// its radius of the axis.
+fn in_a_core(view: &ProjectedModel, i: usize, w: usize) -> bool {
+    let p = Vector2::new((i % w) as f32, (i / w) as f32);
+    view.links.iter().any(|link| {
+        let (s, dist) = link.closest(&p);
+        dist < 0.5 * link.radius_at(s)
+    })
+}
+
+/// The model's silhouette at `q`, 200 grey levels on 40, with the core of every link
+/// ([`in_a_core`]) painted `core_grey`.
+fn painted_with_cores(model: &Model, q: &[f32], camera: &Camera, core_grey: u8) -> Vec<u8> {
+    let view = view_at(model, q, camera);
+    let w = camera.width as usize;
+    painted(model, q, camera)
+        .into_iter()
+        .enumerate()
+        .map(|(i, grey)| {
+            if grey == 200 && in_a_core(&view, i, w) {
+                core_grey
+            } else {
+                grey
+            }
+        })
+        .collect()
+}
+
+/// The grey level of the cores ([`painted_with_cores`]) that lies 0.15 of the contrast above
+/// the mean the model leaves uncovered: dark by the class margin (below 0.2 of it), not by
+/// the core's (below 0.1). The pixels' means stand for the gather's grid's.
+fn shade_between_the_bars(model: &Model, q: &[f32], camera: &Camera) -> u8 {
+    let (lit, bare) = (200.0f32, 40.0f32);
+    // The cores' share of the covered pixels moves the covered mean: solve for the grey g
+    // that sits 0.15 of the contrast above the uncovered mean, with the cores painted g.
+    let view = view_at(model, q, camera);
+    let w = camera.width as usize;
+    let covered: Vec<usize> = covered(model, q, camera)
+        .iter()
+        .enumerate()
+        .filter_map(|(i, &c)| c.then_some(i))
+        .collect();
+    let core = covered.iter().filter(|&&i| in_a_core(&view, i, w)).count();
+    let f = core as f32 / covered.len().max(1) as f32;
+    // g = bare + 0.15 (covered − bare), covered = f g + (1 − f) lit.
+    let g = (bare + 0.15 * (1.0 - f) * (lit - bare)) / (1.0 - 0.15 * f);
+    g.round() as u8
+}
+
+#[test]
+fn a_shade_in_a_links_core_is_the_hands_and_background_there_is_not() {
+    let model = Model::hand().unwrap();
+    let camera = table_camera();
+    let truth = bent_pose();
+    let view = view_at(&model, &truth, &camera);
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let dark = |pixels: &[u8], config: &FillConfig| {
+        let frame = FrameView::packed(pixels, w, h).unwrap();
+        let mut out = FillPoints::default();
+        gather(&view, &camera, &frame, config, &mut out);
+        out.points.iter().filter(|p| !p.bright).count()
+    };
+    let by_class_margin = FillConfig {
+        core_share: 0.0,
+        ..FillConfig::default()
+    };
+    let shade = shade_between_the_bars(&model, &truth, &camera);
+    let shaded = painted_with_cores(&model, &truth, &camera, shade);
+    let bare = painted_with_cores(&model, &truth, &camera, 40);
+    let (shade_before, shade_now, bare_now) = (
+        dark(&shaded, &by_class_margin),
+        dark(&shaded, &FillConfig::default()),
+        dark(&bare, &FillConfig::default()),
+    );
+    println!(
+        "cores painted {shade}: {shade_before} dark samples by the class margin, {shade_now} \
+         with the core's; painted as the background: {bare_now}"
+    );
+    assert!(
+        shade_before > 10,
+        "{shade_before} shaded core samples classed dark"
+    );
+    assert_eq!(shade_now, 0, "shaded core samples classed dark");
+    assert!(
+        bare_now > 10,
+        "{bare_now} background core samples classed dark"
+    );
 }

@@ -314,6 +314,14 @@ fn reacquired_after(
 /// The tracker the local re-acquisition's mechanisms are shown under: they were shown on
 /// seeds the tracker once lost; with its region rows (on by default since) the hand is taken
 /// back on them without those mechanisms, so the rows are off.
+/// The default tracker with every dark region sample classed by the class margin alone, as
+/// before stop 67 (`FillConfig::core_share` 0).
+fn dark_by_the_class_margin() -> TrackerConfig {
+    let mut tracker = TrackerConfig::default();
+    tracker.fill.core_share = 0.0;
+    tracker
+}
+
 fn without_rows() -> TrackerConfig {
     let mut tracker = TrackerConfig::default();
     tracker.fill = FillConfig::OFF;
@@ -466,7 +474,10 @@ fn two_cameras_polish_the_fingers_of_a_re_acquisition_after_its_confirm_phase() 
     // sweep's verdict: over 2751-2910 and 2991-3230, 288 of the 323 seeds tracked to the
     // blackout are re-acquired with it and 281 without; docs/recovery.md.)
     // Both runs turn the local starts 0.3 rad, as when the polish was measured: with the
-    // wider turn (the default since), 3039 is re-acquired by neither.
+    // wider turn (the default since), 3039 is re-acquired by neither. And both class every
+    // dark region sample by the class margin alone, as the tracker did then: with the core's
+    // own margin (`FillConfig::core_share`, the default since stop 67) 3039's track comes
+    // back on neither.
     assert_eq!(
         FinderConfig::default().polish(2),
         Some(0.0),
@@ -491,7 +502,7 @@ fn two_cameras_polish_the_fingers_of_a_re_acquisition_after_its_confirm_phase() 
                 200,
                 80..110,
                 finder,
-                TrackerConfig::default(),
+                dark_by_the_class_margin(),
             )
         };
         let (back, line) = run(with);

@@ -96,6 +96,8 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "fillreach" => c.fill.reach_px = f,
             "fillgather" => c.fill.gather_iterations = f as u8,
             "fillmargin" => c.fill.class_margin = f,
+            "core" => c.fill.core_share = f,
+            "corem" => c.fill.core_margin = f,
             "fillend" => c.fill.full_length_widths = f,
             "shade" => c.shading_refine.every_frames = f as u8,
             "shadegrid" => c.shading_refine.grid = f as u8,
