@@ -23,11 +23,16 @@ fn covered(model: &Model, q: &[f32], camera: &Camera) -> Vec<bool> {
         .collect()
 }
 
-/// The model's silhouette at `q`, 200 grey levels on 40.
+/// The grey level of the painted hand ...
+const LIT: u8 = 200;
+/// ... and of the background around it.
+const BARE: u8 = 40;
+
+/// The model's silhouette at `q`, [`LIT`] on [`BARE`].
 fn painted(model: &Model, q: &[f32], camera: &Camera) -> Vec<u8> {
     covered(model, q, camera)
         .into_iter()
-        .map(|c| if c { 200 } else { 40 })
+        .map(|c| if c { LIT } else { BARE })
         .collect()
 }
 
@@ -195,7 +200,7 @@ fn in_a_core(view: &ProjectedModel, i: usize, w: usize) -> bool {
     })
 }
 
-/// The model's silhouette at `q`, 200 grey levels on 40, with the core of every link
+/// The model's silhouette at `q`, [`LIT`] on [`BARE`], with the core of every link
 /// ([`in_a_core`]) painted `core_grey`.
 fn painted_with_cores(model: &Model, q: &[f32], camera: &Camera, core_grey: u8) -> Vec<u8> {
     let view = view_at(model, q, camera);
@@ -204,7 +209,7 @@ fn painted_with_cores(model: &Model, q: &[f32], camera: &Camera, core_grey: u8) 
         .into_iter()
         .enumerate()
         .map(|(i, grey)| {
-            if grey == 200 && in_a_core(&view, i, w) {
+            if grey == LIT && in_a_core(&view, i, w) {
                 core_grey
             } else {
                 grey
@@ -217,7 +222,7 @@ fn painted_with_cores(model: &Model, q: &[f32], camera: &Camera, core_grey: u8) 
 /// the mean the model leaves uncovered: dark by the class margin (below 0.2 of it), not by
 /// the core's (below 0.1). The pixels' means stand for the gather's grid's.
 fn shade_between_the_bars(model: &Model, q: &[f32], camera: &Camera) -> u8 {
-    let (lit, bare) = (200.0f32, 40.0f32);
+    let (lit, bare) = (f32::from(LIT), f32::from(BARE));
     // The cores' share of the covered pixels moves the covered mean: solve for the grey g
     // that sits 0.15 of the contrast above the uncovered mean, with the cores painted g.
     let view = view_at(model, q, camera);
@@ -253,7 +258,7 @@ fn a_shade_in_a_links_core_is_the_hands_and_background_there_is_not() {
     };
     let shade = shade_between_the_bars(&model, &truth, &camera);
     let shaded = painted_with_cores(&model, &truth, &camera, shade);
-    let bare = painted_with_cores(&model, &truth, &camera, 40);
+    let bare = painted_with_cores(&model, &truth, &camera, BARE);
     let (shade_before, shade_now, bare_now) = (
         dark(&shaded, &by_class_margin),
         dark(&shaded, &FillConfig::default()),
