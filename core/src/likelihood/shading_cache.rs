@@ -102,6 +102,8 @@ fn link_moves(moving: &MovingFrames, frame: u8, child: u8) -> bool {
 impl ShadingCache {
     /// A cache that keeps at most `room` pixels (clamped to [`MAX_CACHED_PIXELS`]; 0 keeps
     /// none, so every region is scored the slow way).
+    // Without the `shading-cache` feature the capacity is 0, and clippy calls the clamp idle.
+    #[allow(clippy::unnecessary_min_or_max)]
     pub fn with_room(room: usize) -> Self {
         ShadingCache {
             pixels: [UNSAMPLED; MAX_CACHED_PIXELS],
