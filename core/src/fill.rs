@@ -90,7 +90,8 @@ pub struct FillConfig {
     /// part darker than the rest) the samples in a link's core are the hand's own, and rows
     /// pulling its outline in past them read the hand smaller, so, with one camera, farther;
     /// background in a link's core means the link is off its finger by most of its width,
-    /// and is darker. Default 0.7 (`docs/robustness.md`, "The sweep on the varied surface").
+    /// and is darker. Default 0.7 (`docs/robustness.md`, "A shadow in a link's core is the
+    /// hand's").
     pub core_share: f32,
     /// The class margin of a dark sample in a link's core ([`FillConfig::core_share`]), as a
     /// share of the contrast. Default 0.4: no brighter than the uncovered mean plus 0.1 of it.
