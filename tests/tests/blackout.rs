@@ -314,14 +314,6 @@ fn reacquired_after(
 /// The tracker the local re-acquisition's mechanisms are shown under: they were shown on
 /// seeds the tracker once lost; with its region rows (on by default since) the hand is taken
 /// back on them without those mechanisms, so the rows are off.
-/// The default tracker with every dark region sample classed by the class margin alone, as
-/// before stop 67 (`FillConfig::core_share` 0).
-fn dark_by_the_class_margin() -> TrackerConfig {
-    let mut tracker = TrackerConfig::default();
-    tracker.fill.core_share = 0.0;
-    tracker
-}
-
 fn without_rows() -> TrackerConfig {
     let mut tracker = TrackerConfig::default();
     tracker.fill = FillConfig::OFF;
@@ -502,7 +494,7 @@ fn two_cameras_polish_the_fingers_of_a_re_acquisition_after_its_confirm_phase() 
                 200,
                 80..110,
                 finder,
-                dark_by_the_class_margin(),
+                common::search::tracker_of_the_seeds(),
             )
         };
         let (back, line) = run(with);
