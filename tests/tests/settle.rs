@@ -1,32 +1,30 @@
 //! After an acquisition the tracker runs `FinderConfig::settle_frames` frames without its
 //! prior on the palm's position. One camera sees the hand's depth only through its size, and
-//! the prior would hold the palm at the depth the accepted leaf guessed: on these mono seeds
-//! the leaf is a few per cent off in depth, and held there the fingers bend to make up the
-//! size, the fingertips staying over 10 px (at 640 wide) off. Settling freely, the same
-//! acquisition comes onto the hand. The tracker's own configuration is untouched throughout.
+//! the prior would hold the palm at the depth the accepted leaf guessed, the fingers bending
+//! to make up the size. On these mono seeds, under the search's and the tracker's defaults,
+//! the same acceptance held by the prior never comes onto the hand; settling freely, it does.
+//! The tracker's own configuration is untouched throughout.
 
 use digiteyes_core::acquire::FinderConfig;
 
 mod common;
 use common::search::{self, acquire_mono, WITHIN_FRAMES};
 
-/// The search's defaults with `settle_frames`, without the confirm phase's depth variants
-/// (`tests/confirm_depth.rs`): they also bring these acceptances onto the hand, with or
-/// without settling, which would hide the mechanism shown here. And without one camera's bar
-/// on the reverse chamfer term (since): the leaves these seeds were first accepted from leave
-/// 4.4 and 4.1 px of their frames' edges unexplained, over its 3.5 px, and are refused in
-/// both arms.
+/// The search's defaults with `settle_frames`.
 fn settling(settle_frames: u8) -> FinderConfig {
-    search::without_reverse_bar(FinderConfig {
+    FinderConfig {
         settle_frames,
-        confirm_depth_share: [0.0, 0.0],
         ..FinderConfig::default()
-    })
+    }
 }
 
 #[test]
 fn an_acquisition_settles_onto_the_hand_without_the_position_prior() {
-    for seed in [4308, 4479] {
+    // Found on seeds 30001-31000 (`acquire_probe --seeds 30001..=31000 --rigs mono`, with
+    // and without `--settle-frames 0`), 58 are acquired only when settling; of the first 12
+    // of those, these two are also held off the hand at this test's 10 px without it, and
+    // end nearer by half with it.
+    for seed in [30012, 30112] {
         let settled = acquire_mono(seed, settling(FinderConfig::default().settle_frames));
         let (held, errors) = (settled.held, settled.errors);
         let with_prior = acquire_mono(seed, settling(0));

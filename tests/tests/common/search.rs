@@ -150,27 +150,15 @@ pub fn without_reverse_bar(mut finder: FinderConfig) -> FinderConfig {
     finder
 }
 
-/// The tracker the acquisition tests' seeds were chosen under: the defaults, with every dark
-/// region sample classed by the class margin alone (`FillConfig::core_share` 0), as before
-/// stop 67. Under the core's own margin (the default since) the tracker reaches the hand
-/// without some of the mechanisms these seeds show (seed 10236 without the pursuit, 4247 and
-/// 4479 nearly as near without the depth variants or the settling): the tests show each
-/// mechanism where it was found, not a sweep's verdict.
-pub fn tracker_of_the_seeds() -> TrackerConfig {
-    let mut tracker = TrackerConfig::default();
-    tracker.fill.core_share = 0.0;
-    tracker
-}
-
 /// `random-mono` `seed` acquired from nothing under the search's `finder`, as
-/// `acquire_probe --limit-px 20` counts it, by [`tracker_of_the_seeds`]. Every frame also
+/// `acquire_probe --limit-px 20` counts it, by the tracker's defaults. Every frame also
 /// checks that the tracker's own configuration stays that, whatever the status machine does
 /// to it meanwhile.
 pub fn acquire_mono(seed: u64, finder: FinderConfig) -> MonoRun {
     let dir = tempfile::tempdir().unwrap();
     let sequence = super::seeded(dir.path(), "random-mono", seed, WITHIN_FRAMES + HELD_FRAMES);
     let truth = frames::truth_states(&sequence);
-    let own = tracker_of_the_seeds();
+    let own = TrackerConfig::default();
     let (mut auto, mut bufs) = searching_with(&sequence, AcquireConfig::default(), own);
     auto.set_finder(finder);
     let mut errors = Vec::new();
