@@ -12,6 +12,12 @@
 //! the last `window` frames (just back in view); seen throughout. The onsets per at-risk frame
 //! of each class say where fingers are lost.
 //!
+//! Each class is also split by whether the *tracked* state's own distal link is seen: the
+//! tracker searches only a link its state shows, so a finger whose last link the image shows
+//! and the track hides cannot be pulled back by its slices. `--at-risk-px` counts a finger at
+//! risk only while nearer the truth than that (with `--limit-px` as low, the frame a finger
+//! first leaves the truth, before its own error can hide its link).
+//!
 //! ```text
 //! digiteyes bench robustness --seeds 60 --frames 200 --keep /tmp/keep
 //! cargo run --release -p digiteyes-host --example reappear_study -- /tmp/keep [--window 10] [--oracle]
@@ -43,6 +49,10 @@ struct Args {
     /// A finger's tip error over this is wrong (px at the frame's own width).
     #[arg(long, default_value_t = 20.0)]
     limit_px: f64,
+    /// A finger is at risk only while its tip error is under this (px; default: the limit):
+    /// a lower bar asks whether a class goes wrong from a finger that was near right.
+    #[arg(long)]
+    at_risk_px: Option<f64>,
     /// Frames the error must stay over the limit for an onset.
     #[arg(long, default_value_t = 5)]
     hold: usize,
@@ -67,6 +77,9 @@ const CLASSES: [&str; 3] = ["hidden now", "back in view", "seen throughout"];
 struct Frame {
     tip_px: Vec<f64>,
     seen: Vec<bool>,
+    /// Per finger: whether the tracked state's own distal link is seen (the model's view,
+    /// which decides whether the tracker searches for it).
+    model_seen: Vec<bool>,
     palm_mm: f64,
     /// Per finger: the largest error of a joint the truth's links show, and of one they hide
     /// (rad; `None` when the finger has no such joint).
@@ -74,6 +87,8 @@ struct Frame {
     /// Per finger: which of its joints (the place in its chain from the palm) is the most
     /// wrong.
     worst_joint: Vec<usize>,
+    /// Per finger: each joint's signed error, tracked less true (rad), from the palm out.
+    signed_rad: Vec<Vec<f64>>,
 }
 
 fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
@@ -91,10 +106,13 @@ fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
     for (t, e) in truth.iter().zip(&tracked) {
         let (pt, pe) = (Poses::compute(model, t)?, Poses::compute(model, e)?);
         let joints_seen = seen::joints(&sequence, &pt, 1);
+        let joints_model_seen = seen::joints(&sequence, &pe, 1);
         let mut tip_px: Vec<f64> = Vec::new();
         let mut seen = Vec::new();
+        let mut model_seen = Vec::new();
         let mut joint_rad = Vec::new();
         let mut worst_joint = Vec::new();
+        let mut signed_rad = Vec::new();
         for (c, camera) in sequence.cameras.iter().enumerate() {
             view.update(model, &pt, camera, 0.0);
             for (f, link) in view.links.iter().filter(|l| l.distal).enumerate() {
@@ -105,6 +123,7 @@ fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
                     // The distal link's own joint: the last state of its chain.
                     let last = chain.last().copied().map(usize::from);
                     seen.push(last.is_some_and(|s| joints_seen[s]));
+                    model_seen.push(last.is_some_and(|s| joints_model_seen[s]));
                     let mut worst = [None::<f64>; 2];
                     let mut most = (0, -1.0);
                     for (place, &s) in chain.iter().enumerate() {
@@ -117,6 +136,12 @@ fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
                         *w = Some(w.map_or(error, |v: f64| v.max(error)));
                     }
                     joint_rad.push(worst);
+                    signed_rad.push(
+                        chain
+                            .iter()
+                            .map(|&s| f64::from(e[usize::from(s)] - t[usize::from(s)]))
+                            .collect(),
+                    );
                     worst_joint.push(most.0);
                 }
                 if let Some(v) = tip_px.get_mut(f) {
@@ -131,9 +156,11 @@ fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
         out.push(Frame {
             tip_px,
             seen,
+            model_seen,
             palm_mm,
             joint_rad,
             worst_joint,
+            signed_rad,
         });
     }
     Ok(out)
@@ -151,6 +178,10 @@ fn main() -> Result<()> {
     // (the four fingers; the thumb apart, as its joints differ).
     let mut worst_place = [[0usize; 5]; 2];
     let mut thumb_place = [[0usize; 5]; 2];
+    // Per group, per class, by whether the tracked state's distal link is seen (0: hidden,
+    // 1: seen): at-risk frames and onsets.
+    let mut by_model = [[[0usize; 2]; 3]; 2];
+    let mut onsets_by_model = [[[0usize; 2]; 3]; 2];
     for base in &args.dirs {
         for dir in kept::seed_dirs(base)? {
             let seed = kept::seed_of(&dir);
@@ -159,7 +190,7 @@ fn main() -> Result<()> {
             let fingers = f.first().map_or(0, |f| f.tip_px.len());
             for finger in 0..fingers {
                 for k in 1..f.len().saturating_sub(args.hold) {
-                    if f[k - 1].tip_px[finger] > args.limit_px {
+                    if f[k - 1].tip_px[finger] > args.at_risk_px.unwrap_or(args.limit_px) {
                         continue;
                     }
                     let class = if !f[k].seen[finger] {
@@ -170,10 +201,13 @@ fn main() -> Result<()> {
                         2
                     };
                     at_risk[g][class] += 1;
+                    let model = usize::from(f[k].model_seen[finger]);
+                    by_model[g][class][model] += 1;
                     let onset = (k..k + args.hold).all(|j| f[j].tip_px[finger] > args.limit_px)
                         && f[k].palm_mm <= args.palm_mm;
                     if onset {
                         onsets[g][class] += 1;
+                        onsets_by_model[g][class][model] += 1;
                         let place = f[k].worst_joint[finger].min(4);
                         if finger + 1 == fingers {
                             thumb_place[g][place] += 1;
@@ -184,9 +218,15 @@ fn main() -> Result<()> {
                             let [shown, hidden] = f[k].joint_rad[finger].map(|e| {
                                 e.map_or("-".into(), |r| format!("{:.0}", r.to_degrees()))
                             });
+                            let signed: Vec<String> = f[k].signed_rad[finger]
+                                .iter()
+                                .map(|r| format!("{:+.0}", r.to_degrees()))
+                                .collect();
                             println!(
-                                "onset seed {seed} finger {finger} frame {k} {}: shown {shown}°, hidden {hidden}°",
-                                CLASSES[class]
+                                "onset seed {seed} finger {finger} frame {k} {}, the track's distal link {}: shown {shown}°, hidden {hidden}°; tracked − true {}°",
+                                CLASSES[class],
+                                if model == 1 { "seen" } else { "hidden" },
+                                signed.join(" ")
                             );
                         }
                         for (v, e) in at_onset[g][class].iter_mut().zip(f[k].joint_rad[finger]) {
@@ -225,6 +265,15 @@ fn main() -> Result<()> {
                 median(hidden),
                 hidden.len()
             );
+            for (m, view) in ["hidden", "seen"].iter().enumerate() {
+                println!(
+                    "  {:>16}  the track's own distal link {view:>6}: {:>6} at-risk, {:>4} onsets, {:.2} per 100",
+                    "",
+                    by_model[g][c][m],
+                    onsets_by_model[g][c][m],
+                    100.0 * onsets_by_model[g][c][m] as f64 / by_model[g][c][m].max(1) as f64
+                );
+            }
         }
     }
     Ok(())
