@@ -1,10 +1,11 @@
 //! The region samples (`fill::gather`) on a frame painted from the model's own silhouette:
 //! none where the model lies on its image, many where it has moved off, each assigned to a
 //! link that exists, and a gather that pulls the moved hand back; the hand's own shade, on its
-//! shaded side or in a link's core, is not classed as background.
+//! shaded side or in a link's core, is not classed as background; and a link the model hides
+//! is preferred for the hand it leaves uncovered.
 
 use digiteyes_core::camera::Camera;
-use digiteyes_core::fill::{gather, FillConfig, FillPoints, MAX_FILL_POINTS};
+use digiteyes_core::fill::{gather, hidden_link, FillConfig, FillPoints, MAX_FILL_POINTS};
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::model::Model;
 use digiteyes_core::projection::ProjectedModel;
@@ -276,5 +277,71 @@ fn a_shade_in_a_links_core_is_the_hands_and_background_there_is_not() {
     assert!(
         bare_now > 10,
         "{bare_now} background core samples classed dark"
+    );
+}
+
+/// The model frames of the links of `view` the model hides wholly from `camera`.
+fn hidden_frames(view: &ProjectedModel, camera: &Camera) -> Vec<u8> {
+    (0..view.links.len())
+        .filter(|&i| hidden_link(view, camera, i))
+        .map(|i| view.links[i].frame)
+        .collect()
+}
+
+#[test]
+fn a_link_the_model_hides_is_preferred_for_the_hand_it_leaves_uncovered() {
+    let model = Model::hand().unwrap();
+    let camera = table_camera();
+    let truth = bent_pose();
+    let pixels = painted(&model, &truth, &camera);
+    let frame = FrameView::packed(&pixels, camera.width as usize, camera.height as usize).unwrap();
+    let (mut as_any_sum, mut preferred_sum) = (0, 0);
+    for finger in 0..4 {
+        // The finger held curled under the palm while the image shows it as it was.
+        let mut held = truth.clone();
+        for (j, c) in [1.2f32, 1.4, 1.0].iter().enumerate() {
+            held[8 + 4 * finger + j] = *c;
+        }
+        let view = view_at(&model, &held, &camera);
+        let hidden = hidden_frames(&view, &camera);
+        assert!(!hidden.is_empty(), "finger {finger}: nothing hidden");
+        let to_hidden = |share: f32| {
+            let config = FillConfig {
+                hidden_gap_share: share,
+                ..FillConfig::default()
+            };
+            let mut out = FillPoints::default();
+            gather(&view, &camera, &frame, &config, &mut out);
+            out.points
+                .iter()
+                .filter(|p| p.bright && hidden.contains(&p.frame))
+                .count()
+        };
+        let (never, nan, as_any, preferred) = (
+            to_hidden(f32::INFINITY),
+            to_hidden(f32::NAN),
+            to_hidden(1.0),
+            to_hidden(0.5),
+        );
+        println!(
+            "finger {finger} curled under the palm: {} links hidden; bright samples to them: \
+             {never} never, {as_any} as any link, {preferred} preferred",
+            hidden.len()
+        );
+        assert_eq!(
+            (never, nan),
+            (0, 0),
+            "finger {finger}: hidden links passed over"
+        );
+        assert!(
+            preferred >= as_any,
+            "finger {finger}: {preferred} samples preferred, {as_any} as any link"
+        );
+        as_any_sum += as_any;
+        preferred_sum += preferred;
+    }
+    assert!(
+        preferred_sum > as_any_sum,
+        "{preferred_sum} samples to hidden links preferred, {as_any_sum} as any link"
     );
 }

@@ -17,7 +17,9 @@
 //! margin, `shadefingers` its fingers a call, `shadecurl` and `shadesingle` its moves (0 / 1),
 //! `shaderad` its first step (rad; then half and a quarter), `shadelevels` how many steps,
 //! `shadecap` its residual's cap per pixel, grey levels; 0: none, `shadeclamp` the light's
-//! term clamped at 0, 0 / 1).
+//! term clamped at 0, 0 / 1); the region rows' `fill` (weight), `fillgrid`, `fillreach`,
+//! `fillgather`, `fillmargin`, `core`, `corem`, `fillend` and `fillhidden` (the share at which
+//! a hidden link's gap counts; `inf`: hidden links never take a bright sample).
 //! Each group's row also gives its frames far from the hand and not flagged (`far`)
 //! and the lost flag's precision and recall (`lostP`, `lostR`), as the benchmark counts them,
 //! and the median share of frames held (`held50`, as `eval`'s frames held).

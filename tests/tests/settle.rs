@@ -20,11 +20,12 @@ fn settling(settle_frames: u8) -> FinderConfig {
 
 #[test]
 fn an_acquisition_settles_onto_the_hand_without_the_position_prior() {
-    // Found on seeds 30001-31000 (`acquire_probe --seeds 30001..=31000 --rigs mono`, with
-    // and without `--settle-frames 0`), 58 are acquired only when settling; of the first 12
-    // of those, these two are also held off the hand at this test's 10 px without it, and
-    // end nearer by half with it.
-    for seed in [30012, 30112] {
+    // Found on seeds 30001-30600 under stop 69's defaults, each seed run as below with and
+    // without settling and kept when it passes this test's own bars (acquired within 30
+    // frames settling, held off the hand at 10 px with the prior, ending nearer by half):
+    // 30168, 30270, 30461 and 30574; these are the first two. (Stop 68's 30012 and 30112 now
+    // come onto the hand with the prior too.)
+    for seed in [30168, 30270] {
         let settled = acquire_mono(seed, settling(FinderConfig::default().settle_frames));
         let (held, errors) = (settled.held, settled.errors);
         let with_prior = acquire_mono(seed, settling(0));

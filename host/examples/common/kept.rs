@@ -98,6 +98,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "fillmargin" => c.fill.class_margin = f,
             "core" => c.fill.core_share = f,
             "corem" => c.fill.core_margin = f,
+            "fillhidden" => c.fill.hidden_gap_share = f,
             "fillend" => c.fill.full_length_widths = f,
             "shade" => c.shading_refine.every_frames = f as u8,
             "shadegrid" => c.shading_refine.grid = f as u8,
