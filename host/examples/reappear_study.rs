@@ -53,6 +53,10 @@ struct Args {
     /// a lower bar asks whether a class goes wrong from a finger that was near right.
     #[arg(long)]
     at_risk_px: Option<f64>,
+    /// Read each seed's tracked states from `DIR/seedN.csv` (as `kept_ab --states-out`
+    /// keeps a variant's) instead of the seed's own `states.csv`.
+    #[arg(long)]
+    states_dir: Option<PathBuf>,
     /// Frames the error must stay over the limit for an onset.
     #[arg(long, default_value_t = 5)]
     hold: usize,
@@ -91,7 +95,7 @@ struct Frame {
     signed_rad: Vec<Vec<f64>>,
 }
 
-fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
+fn frames(dir: &std::path::Path, oracle: bool, states: &std::path::Path) -> Result<Vec<Frame>> {
     let sequence = Sequence::open(dir)?;
     let model = &sequence.model;
     let n = sequence.n_states();
@@ -99,7 +103,7 @@ fn frames(dir: &std::path::Path, oracle: bool) -> Result<Vec<Frame>> {
     let tracked = if oracle {
         seen::oracle(&sequence, &truth, 1, seen::Unseen::Hold)?.0
     } else {
-        kept::f32s(&read_states(&dir.join("states.csv"), n)?.rows)
+        kept::f32s(&read_states(states, n)?.rows)
     };
     let mut view = ProjectedModel::default();
     let mut out = Vec::new();
@@ -186,7 +190,11 @@ fn main() -> Result<()> {
         for dir in kept::seed_dirs(base)? {
             let seed = kept::seed_of(&dir);
             let g = (seed % 2) as usize;
-            let f = frames(&dir, args.oracle)?;
+            let states = match &args.states_dir {
+                Some(d) => d.join(format!("seed{seed}.csv")),
+                None => dir.join("states.csv"),
+            };
+            let f = frames(&dir, args.oracle, &states)?;
             let fingers = f.first().map_or(0, |f| f.tip_px.len());
             for finger in 0..fingers {
                 for k in 1..f.len().saturating_sub(args.hold) {
