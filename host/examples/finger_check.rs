@@ -204,23 +204,6 @@ fn score_state(rig: &Rig<'_>, q: &[f32]) -> Option<(Vec<f32>, Vec<f32>, f32)> {
     Some((bright, chamfer, unexplained))
 }
 
-/// Distance between segments `a0a1` and `b0b1` (mm), by sampling (a study, not the core).
-fn segment_distance(
-    a0: &digiteyes_core::nalgebra::Vector3<f32>,
-    a1: &digiteyes_core::nalgebra::Vector3<f32>,
-    b0: &digiteyes_core::nalgebra::Vector3<f32>,
-    b1: &digiteyes_core::nalgebra::Vector3<f32>,
-) -> f32 {
-    let mut best = f32::INFINITY;
-    for i in 0..=16 {
-        let p = a0 + (a1 - a0) * (i as f32 / 16.0);
-        let d = b1 - b0;
-        let t = ((p - b0).dot(&d) / d.norm_squared().max(1e-9)).clamp(0.0, 1.0);
-        best = best.min((p - (b0 + d * t)).norm());
-    }
-    best
-}
-
 /// Per finger, how deep its capsules sink into another finger's (mm, 0 when apart).
 fn penetration(rig: &Rig<'_>, q: &[f32]) -> Option<Vec<f32>> {
     let poses = Poses::compute(rig.model, q).ok()?;
@@ -238,7 +221,7 @@ fn penetration(rig: &Rig<'_>, q: &[f32]) -> Option<Vec<f32>> {
             if fa == fb {
                 continue;
             }
-            let d = segment_distance(&a.p0, &a.p1, &b.p0, &b.p1);
+            let d = kept::segment_distance_mm(&a.p0, &a.p1, &b.p0, &b.p1);
             depth[fa] = depth[fa].max(a.radius_mm + b.radius_mm - d);
         }
     }

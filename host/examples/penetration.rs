@@ -65,24 +65,6 @@ impl PalmBox {
     }
 }
 
-/// Shortest distance between segments `p0–p1` and `q0–q1` (mm).
-fn segment_distance(
-    p0: &Vector3<f32>,
-    p1: &Vector3<f32>,
-    q0: &Vector3<f32>,
-    q1: &Vector3<f32>,
-) -> f32 {
-    // Sampled: exact enough for a study, and free of the degenerate cases.
-    let mut best = f32::INFINITY;
-    for i in 0..=8 {
-        let a = p0 + (p1 - p0) * (i as f32 / 8.0);
-        let d = q1 - q0;
-        let t = ((a - q0).dot(&d) / d.norm_squared().max(1e-9)).clamp(0.0, 1.0);
-        best = best.min((a - (q0 + d * t)).norm());
-    }
-    best
-}
-
 /// Per finger: (into the palm, into other fingers) penetration depth (mm, 0 when none).
 fn penetration(
     view: &ProjectedModel,
@@ -108,7 +90,7 @@ fn penetration(
                 continue;
             }
             let depth = link.radius_mm + other.radius_mm
-                - segment_distance(&link.p0, &link.p1, &other.p0, &other.p1);
+                - kept::segment_distance_mm(&link.p0, &link.p1, &other.p0, &other.p1);
             out[f][1] = out[f][1].max(depth);
         }
     }

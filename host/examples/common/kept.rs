@@ -206,3 +206,21 @@ pub fn tip_error_px(model: &Model, cameras: &[Camera], a: &[f32], b: &[f32]) -> 
         sum / n as f32
     }
 }
+
+/// Shortest distance (mm) between the segments `a0–a1` and `b0–b1`, from 17 points along the
+/// first: exact enough for a study, and free of the parallel and degenerate cases.
+pub fn segment_distance_mm(
+    a0: &nalgebra::Vector3<f32>,
+    a1: &nalgebra::Vector3<f32>,
+    b0: &nalgebra::Vector3<f32>,
+    b1: &nalgebra::Vector3<f32>,
+) -> f32 {
+    let mut best = f32::INFINITY;
+    for i in 0..=16 {
+        let p = a0 + (a1 - a0) * (i as f32 / 16.0);
+        let d = b1 - b0;
+        let t = ((p - b0).dot(&d) / d.norm_squared().max(1e-9)).clamp(0.0, 1.0);
+        best = best.min((p - (b0 + d * t)).norm());
+    }
+    best
+}
