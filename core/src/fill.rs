@@ -103,8 +103,8 @@ pub struct FillConfig {
     /// preferred: the image shows hand where the model shows none, and a link the model has
     /// put out of sight beside it is the likeliest owner, where a visible link's outline is
     /// already held by its own edges. 1: every link alike (before stop 69); infinite (or NaN):
-    /// hidden links never chosen. Default 0.5: one camera +1.6 points of track life on 420
-    /// fresh sweep seeds, two level (`docs/robustness.md`, "A hidden link takes the hand it
+    /// hidden links never chosen. Default 0.5: one camera +1.3 points of track life on 600
+    /// fresh sweep seeds, two +0.7 (`docs/robustness.md`, "A hidden link takes the hand it
     /// leaves uncovered").
     pub hidden_gap_share: f32,
 }
