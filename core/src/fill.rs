@@ -388,13 +388,10 @@ pub fn gather(
     }
     let threshold = 0.5 * (covered + uncovered);
     let margin = config.class_margin.max(0.0) * contrast;
-    // Which links the model hides: asked only when they are ranked apart.
-    let mut hidden = [false; MAX_LINKS];
-    if config.hidden_gap_share != 1.0 {
-        for (index, h) in hidden.iter_mut().enumerate().take(view.links.len()) {
-            *h = hidden_link(view, camera, index);
-        }
-    }
+    // Which links the model hides: asked once, at the first bright sample left uncovered,
+    // and only when hidden links are ranked apart.
+    let mut hidden: Option<[bool; MAX_LINKS]> = None;
+    let ranks_hidden = config.hidden_gap_share != 1.0;
     for j in 0..grid {
         for i in 0..grid {
             let c = class[j * grid + i];
@@ -406,7 +403,16 @@ pub fn gather(
             let p = at(i, j);
             let link = match (c, bright) {
                 (UNCOVERED, true) => {
-                    nearest_outline(view, &p, reach, &hidden, config.hidden_gap_share)
+                    let hidden = hidden.get_or_insert_with(|| {
+                        let mut flags = [false; MAX_LINKS];
+                        if ranks_hidden {
+                            for (index, h) in flags.iter_mut().enumerate().take(view.links.len()) {
+                                *h = hidden_link(view, camera, index);
+                            }
+                        }
+                        flags
+                    });
+                    nearest_outline(view, &p, reach, hidden, config.hidden_gap_share)
                 }
                 (OFF_FRAME | PALM | UNCOVERED, _) | (_, true) => None,
                 (_, false) => Some(usize::from(c))
