@@ -36,10 +36,11 @@
 
 use anyhow::Result;
 use clap::Parser;
-use digiteyes_host::bench::robustness::count_run;
+use digiteyes_host::bench::robustness::{count_run, FrameCounts};
 use digiteyes_host::eval::{evaluate, stats};
 use digiteyes_host::parallel;
-use digiteyes_host::track::track_sequence_opts;
+use digiteyes_host::track::{track_sequence_opts, TrackOptions};
+use digiteyes_host::TrackerConfig;
 use std::path::PathBuf;
 
 #[path = "common/kept.rs"]
@@ -63,6 +64,14 @@ struct Args {
     /// frame by frame.
     #[arg(long)]
     states_out: Option<PathBuf>,
+    /// Track each variant this many times, draw `d` with the palm position prior's weight
+    /// moved by `d` units in its last place, and judge each seed by its mean over the draws.
+    /// A change in the last bit sends a track standing at a fork down the other branch, so one
+    /// draw of the first variant is a reference with its own luck, shared by every comparison
+    /// made against it (`docs/robustness.md`, "The sweep's null"); the per-draw means of each
+    /// group are printed, to show that spread.
+    #[arg(long, default_value_t = 1)]
+    draws: u32,
 }
 
 fn main() -> Result<()> {
@@ -90,43 +99,23 @@ fn main() -> Result<()> {
     let mut first: Option<Vec<Run>> = None;
     for name in &args.variants {
         let (config, options) = variant(name)?;
-        let runs = parallel::map(&seeds, args.jobs, |(seed, dir)| {
-            let out =
-                std::env::temp_dir().join(format!("kept_ab_{}_{seed}.csv", std::process::id()));
-            let r = track_sequence_opts(dir, &out, config, false, None, &options).and_then(|_| {
-                let report = evaluate(dir, &out)?;
-                let judged = count_run(dir, &out, &report)?;
-                Ok((report, judged))
-            });
-            if let (Ok(_), Some(keep)) = (&r, &args.states_out) {
-                let dir = keep.join(name);
-                let kept = std::fs::create_dir_all(&dir)
-                    .and_then(|_| std::fs::copy(&out, dir.join(format!("seed{seed}.csv"))));
-                if let Err(e) = kept {
-                    eprintln!("seed {seed}: its states not kept: {e}");
-                }
-            }
-            let _ = std::fs::remove_file(&out);
-            match r {
-                Ok((r, judged)) => {
-                    let tip = r.cameras.iter().map(|c| c.fingertip_mean_px).sum::<f64>()
-                        / r.cameras.len() as f64;
-                    Some((
-                        *seed,
-                        r.track_life,
-                        r.joint_rms_deg,
-                        tip,
-                        judged,
-                        r.held_share,
-                    ))
-                }
-                Err(e) => {
-                    eprintln!("seed {seed}: {e:#}");
-                    None
-                }
-            }
-        });
-        let results: Vec<_> = runs.into_iter().flatten().collect();
+        let mut draws: Vec<Vec<Row>> = Vec::new();
+        for draw in 0..args.draws.max(1) {
+            let mut config = config;
+            let prior = &mut config.motion.prior.translation;
+            *prior *= 1.0 + draw as f32 * f32::EPSILON;
+            // The states of the first draw are the ones kept.
+            let keep = if draw == 0 {
+                args.states_out.as_ref()
+            } else {
+                None
+            };
+            draws.push(track_all(&seeds, args.jobs, name, config, &options, keep));
+        }
+        if draws.len() > 1 {
+            print_draws(name, &draws);
+        }
+        let results = mean_of_draws(&draws);
         let lives: Vec<Run> = results.iter().map(|r| (r.0, r.1, r.5)).collect();
         match &first {
             None => first = Some(lives),
@@ -166,6 +155,107 @@ fn main() -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// One seed tracked once: the seed, its track life, joint RMS (deg), mean fingertip error
+/// (px), the benchmark's counts, and its share of frames held.
+type Row = (u64, f64, f64, f64, FrameCounts, f64);
+
+/// Every seed tracked under `config` and `options`; its states kept under `keep/name` if asked.
+fn track_all(
+    seeds: &[(u64, PathBuf)],
+    jobs: usize,
+    name: &str,
+    config: TrackerConfig,
+    options: &TrackOptions,
+    keep: Option<&PathBuf>,
+) -> Vec<Row> {
+    let runs = parallel::map(seeds, jobs, |(seed, dir)| {
+        let out = std::env::temp_dir().join(format!("kept_ab_{}_{seed}.csv", std::process::id()));
+        let r = track_sequence_opts(dir, &out, config, false, None, options).and_then(|_| {
+            let report = evaluate(dir, &out)?;
+            let judged = count_run(dir, &out, &report)?;
+            Ok((report, judged))
+        });
+        if let (Ok(_), Some(keep)) = (&r, keep) {
+            let dir = keep.join(name);
+            let kept = std::fs::create_dir_all(&dir)
+                .and_then(|_| std::fs::copy(&out, dir.join(format!("seed{seed}.csv"))));
+            if let Err(e) = kept {
+                eprintln!("seed {seed}: its states not kept: {e}");
+            }
+        }
+        let _ = std::fs::remove_file(&out);
+        match r {
+            Ok((r, judged)) => {
+                let tip = r.cameras.iter().map(|c| c.fingertip_mean_px).sum::<f64>()
+                    / r.cameras.len() as f64;
+                Some((
+                    *seed,
+                    r.track_life,
+                    r.joint_rms_deg,
+                    tip,
+                    judged,
+                    r.held_share,
+                ))
+            }
+            Err(e) => {
+                eprintln!("seed {seed}: {e:#}");
+                None
+            }
+        }
+    });
+    runs.into_iter().flatten().collect()
+}
+
+/// Each group's mean track life per draw, and the spread of those means.
+fn print_draws(name: &str, draws: &[Vec<Row>]) {
+    for (group, parity) in [("mono", 1), ("stereo", 0)] {
+        let means: Vec<f64> = draws
+            .iter()
+            .map(|rows| {
+                let lives: Vec<f64> = rows
+                    .iter()
+                    .filter(|r| r.0 % 2 == parity)
+                    .map(|r| r.1)
+                    .collect();
+                100.0 * lives.iter().sum::<f64>() / lives.len().max(1) as f64
+            })
+            .collect();
+        let (lo, hi) = means
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &m| {
+                (lo.min(m), hi.max(m))
+            });
+        let text: Vec<String> = means.iter().map(|m| format!("{m:.1}")).collect();
+        println!(
+            "  draws {name} {group}: mean life per draw {} (range {:.1} points)",
+            text.join(" "),
+            hi - lo
+        );
+    }
+}
+
+/// Each seed tracked in every draw, its life and share held averaged over them; the other
+/// figures are the first draw's.
+fn mean_of_draws(draws: &[Vec<Row>]) -> Vec<Row> {
+    let Some((first, rest)) = draws.split_first() else {
+        return Vec::new();
+    };
+    first
+        .iter()
+        .filter_map(|row| {
+            let same: Vec<&Row> = rest
+                .iter()
+                .map(|rows| rows.iter().find(|r| r.0 == row.0))
+                .collect::<Option<_>>()?;
+            let n = (same.len() + 1) as f64;
+            let mut mean = *row;
+            mean.1 = (row.1 + same.iter().map(|r| r.1).sum::<f64>()) / n;
+            mean.5 = (row.5 + same.iter().map(|r| r.5).sum::<f64>()) / n;
+            Some(mean)
+        })
+        .collect()
 }
 
 /// One seed's run under a variant: the seed, its track life and its share of frames held.
