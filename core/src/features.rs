@@ -17,7 +17,7 @@ use crate::frame::FrameView;
 use crate::projection::Bounds;
 use crate::projection::ProjectedLink;
 use crate::projection::ProjectedModel;
-use crate::visibility::{candidates, cover_among, hidden_within, Cover};
+use crate::visibility::{candidates, cover_among, Cover};
 
 mod axis_line;
 mod palm;
@@ -89,13 +89,6 @@ pub struct FeatureConfig {
     /// inside the outline. Default 0.5: stereo track life +4.9 points on 360 fresh seeds, mono
     /// level (`docs/robustness.md`, "The outermost edge").
     pub outermost_share: f32,
-    /// A slice (or tip) window is masked, as if hidden, when a nearer part of the hand lies
-    /// within this distance of its predicted edge, across or along the link (px): the image
-    /// edge there may be the occluder's. 0 keeps only the hidden edges masked.
-    pub occluder_margin_px: f32,
-    /// Over a farther part of the hand, fall back to an edge of either sign where no valley
-    /// is found.
-    pub over_hand_any_edge: bool,
 }
 
 impl Default for FeatureConfig {
@@ -114,8 +107,6 @@ impl Default for FeatureConfig {
             palm_edges: true,
             max_edge_angle_rad: core::f32::consts::FRAC_PI_6,
             outermost_share: 0.5,
-            occluder_margin_px: 0.0,
-            over_hand_any_edge: true,
         }
     }
 }
@@ -482,11 +473,6 @@ fn search_link<W: FnMut(&SearchWindow)>(
     let slices = usize::from(config.slices_per_link).clamp(1, MAX_SLICES_PER_LINK);
     let mut profile = [0.0f32; MAX_WINDOW];
     let tangent_limit = config.edge_tangent_limit();
-    let occluder_margin = if config.occluder_margin_px.is_finite() {
-        config.occluder_margin_px.clamp(0.0, half)
-    } else {
-        0.0
-    };
     let slice_s = |k: usize| {
         if slices == 1 {
             0.5 * (config.span[0] + config.span[1])
@@ -498,10 +484,9 @@ fn search_link<W: FnMut(&SearchWindow)>(
     // `PROBE_BEYOND_EDGE_PX` beyond each) lies within the link's own bounds grown by that
     // distance, so only the links and palm whose bounds meet that box are tested.
     let (among, palm) = if config.mask_occluded {
-        let probe = PROBE_BEYOND_EDGE_PX.max(occluder_margin);
-        let reach = Vector2::new(probe, probe);
+        let reach = Vector2::new(PROBE_BEYOND_EDGE_PX, PROBE_BEYOND_EDGE_PX);
         let tip = if config.searches_tip(link) {
-            link.b + dir * (link.tip_offset + probe)
+            link.b + dir * (link.tip_offset + PROBE_BEYOND_EDGE_PX)
         } else {
             link.b
         };
@@ -536,22 +521,6 @@ fn search_link<W: FnMut(&SearchWindow)>(
                     watched(WindowOutcome::Masked);
                     return None;
                 }
-                Cover::Behind | Cover::Clear
-                    if occluder_margin > 0.0
-                        && hidden_within(
-                            view,
-                            camera,
-                            &among,
-                            palm,
-                            &centre,
-                            depth,
-                            occluder_margin,
-                        ) =>
-                {
-                    out.masked += 1;
-                    watched(WindowOutcome::Masked);
-                    return None;
-                }
                 Cover::Behind => over_hand = true,
                 Cover::Clear => {
                     over_hand = cover_among(
@@ -573,12 +542,8 @@ fn search_link<W: FnMut(&SearchWindow)>(
         }
         out.expected += 1;
         let edge = if over_hand {
-            find_valley(&profile[..window], config.min_contrast).or_else(|| {
-                config
-                    .over_hand_any_edge
-                    .then(|| find_edge(&profile[..window], Polarity::Any, config.min_contrast))
-                    .flatten()
-            })
+            find_valley(&profile[..window], config.min_contrast)
+                .or_else(|| find_edge(&profile[..window], Polarity::Any, config.min_contrast))
         } else if config.outermost_share > 0.0 && !tip {
             find_outermost_edge(
                 &profile[..window],

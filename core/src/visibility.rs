@@ -58,49 +58,6 @@ pub fn candidates(
     (out, palm)
 }
 
-/// Whether a part among `among` (indices into `view.links`) or, if `palm`, the palm lies
-/// nearer than `depth` (mm) within `margin_px` of image point `p`: a link when `p` is inside
-/// its outline grown by the margin, the palm when the ray through one of the four points
-/// `margin_px` from `p` along the image axes meets the box nearer. `p` itself is
-/// [`cover_among`]'s question. The parts must be [`candidates`] for a box holding every point
-/// within `margin_px` of `p`.
-#[inline(never)] // the visibility mask of Table 4.1's features stage: kept whole for profiles
-pub fn hidden_within(
-    view: &ProjectedModel,
-    camera: &Camera,
-    among: &[u8],
-    palm: bool,
-    p: &Vector2<f32>,
-    depth: f32,
-    margin_px: f32,
-) -> bool {
-    let m = margin_px;
-    for &j in among {
-        let Some(other) = view.links.get(usize::from(j)) else {
-            continue;
-        };
-        let b = &other.bounds;
-        if p.x < b.min.x - m || p.y < b.min.y - m || p.x > b.max.x + m || p.y > b.max.y + m {
-            continue;
-        }
-        let (s, dist) = other.closest(p);
-        if dist < other.radius_at(s) + m && other.depth_at(s) < depth {
-            return true;
-        }
-    }
-    let (true, Some(box_)) = (palm, &view.palm) else {
-        return false;
-    };
-    [
-        Vector2::new(m, 0.0),
-        Vector2::new(-m, 0.0),
-        Vector2::new(0.0, m),
-        Vector2::new(0.0, -m),
-    ]
-    .iter()
-    .any(|d| box_.depth_at(camera, &(p + d)).is_some_and(|z| z < depth))
-}
-
 /// [`cover`] restricted to the links `among` (indices into `view.links`) and, if `palm`, the
 /// palm: the same answer as `cover` when they are [`candidates`] for a box holding `p`.
 #[inline(never)] // the visibility mask of Table 4.1's features stage: kept whole for profiles

@@ -83,8 +83,6 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "palm" => c.features.palm_edges = f != 0.0,
             "angle" => c.features.max_edge_angle_rad = f.to_radians(),
             "outer" => c.features.outermost_share = f,
-            "occm" => c.features.occluder_margin_px = f,
-            "overany" => c.features.over_hand_any_edge = f != 0.0,
             "knuckle" => c.features.knuckle_tips = f != 0.0,
             "fvf" => c.motion.full_velocity_found = f,
             "palmw" => c.estimator.palm_edge_weight = f,
