@@ -28,10 +28,13 @@
 //! two-sided sign test's p over those, and the mean change of the share of frames held (the
 //! median of 30 seeds moves by 10–20 points between sweeps by chance alone; pairing the same
 //! seeds sees far smaller effects).
+//! With `--draws N` every variant is tracked N times under last-bit changes and each seed is
+//! judged by its mean, so the first variant's luck on one run is not every comparison's.
 //! For trying a change quickly; the benchmark itself is the judge.
 //!
 //! ```text
 //! cargo run --release -p digiteyes-host --example kept_ab -- /tmp/keep default pj=500
+//! cargo run --release -p digiteyes-host --example kept_ab -- /tmp/keep --draws 3 default k=2
 //! ```
 
 use anyhow::Result;
