@@ -331,6 +331,24 @@ impl Tracker {
         report
     }
 
+    /// [`Tracker::track_at_most`] without region rows and without the silhouette check (the
+    /// frame's agreement reported as 1, the reference untouched), which are back in place
+    /// afterwards, error or not: a hypothesis only carried along between scored frames
+    /// ([`HypothesesConfig::light_others`](crate::hypotheses::HypothesesConfig::light_others)),
+    /// for about half the instructions of a frame.
+    pub fn track_light(
+        &mut self,
+        iterations: u8,
+        frames: &[FrameView<'_>],
+    ) -> Result<FrameReport, TrackerError> {
+        let own = self.config;
+        self.config.fill.weight = 0.0;
+        self.config.silhouette_grid = 0;
+        let report = self.track_at_most(iterations, frames);
+        self.config = own;
+        report
+    }
+
     /// The prior toward the predicted state the frames to come are tracked under, in place
     /// of the configured one (which [`Tracker::config`] then shows). Weights that are not
     /// finite and non-negative are refused: `false`, and nothing changes.
@@ -518,7 +536,7 @@ impl Tracker {
         report.silhouette_agreement = self.silhouette_agreement(measurer);
         let drop = self.config.lost_silhouette_drop;
         let mut silhouette_dropped = false;
-        if drop > 0.0 {
+        if drop > 0.0 && self.config.silhouette_grid > 0 {
             let reference = *self
                 .silhouette_reference
                 .get_or_insert(report.silhouette_agreement);
@@ -561,7 +579,8 @@ impl Tracker {
             }
             self.velocity = Some(velocity);
             self.state = q;
-            if !report.lost {
+            // No check, no news of the images' level: the reference stays.
+            if !report.lost && self.config.silhouette_grid > 0 {
                 if let Some(reference) = self.silhouette_reference.as_mut() {
                     *reference +=
                         SILHOUETTE_REFERENCE_RATE * (report.silhouette_agreement - *reference);

@@ -6,7 +6,9 @@
 //! `palmw`, `tipw`, `fvf`, `outer`, `knuckle` (0: no knuckle tips), `bounds` (0: the plain
 //! step); `angle` the edge-direction limit in degrees (90: off); `huber`, `tukey` the robust
 //! kernel's px; `k`, `s`, `spawn`, `step`, `smem`, `switch` the hypotheses (their count, scoring
-//! period, samples, their step in spread units, score memory, switch margin); `csmem`, `cswitch` the confirm phase's score
+//! period, samples, their step in spread units, score memory, switch margin), `si`, `oi` (a
+//! sample's and another hypothesis' iterations), `keepf` (0 / 1: fingers undone weighed),
+//! `lo` (0 / 1: the others tracked light between scored frames); `csmem`, `cswitch` the confirm phase's score
 //! memory and switch margin; `settle` the frames without the palm's position prior after an
 //! acquisition; `cdepth1` one camera's confirm-phase depth share; `rival` the share of its offset that makes two hypotheses rival depths, `rivalm` the margin within which a rival leaves a confirm frame unclaimed (negative: all claimed); `cframes` its frames; `watch`
 //! its period, `drop` its bar; `depth1` one camera's local depth share; `turn` the local

@@ -1,11 +1,11 @@
 //! Tracks a rendered sequence with K hypotheses, for counting instructions per frame under
 //! callgrind (`scripts/hypotheses-instructions` collects only `MultiTracker::track`).
 //!
-//! `cargo run --release -p digiteyes-tests --example hypotheses_cost -- SEQ K FRAMES [EVERY [REVERSE [KEEP [SAMPLE_ITER [OTHER_ITER]]]]]`
+//! `cargo run --release -p digiteyes-tests --example hypotheses_cost -- SEQ K FRAMES [EVERY [REVERSE [KEEP [SAMPLE_ITER [OTHER_ITER [LIGHT]]]]]]`
 //! (EVERY: `HypothesesConfig::score_every_frames`, default 1; REVERSE: the likelihood's
 //! `reverse_weight`, default the hypotheses' own; KEEP: `keep_fingers`, 1 or 0, default the
 //! hypotheses' own; SAMPLE_ITER, OTHER_ITER: `sample_iterations` and `other_iterations`,
-//! default the hypotheses' own).
+//! default the hypotheses' own; LIGHT: `light_others`, 1 or 0, default the hypotheses' own).
 
 use anyhow::{Context, Result};
 use digiteyes_core::frame::FrameView;
@@ -39,6 +39,12 @@ fn main() -> Result<()> {
         .get(7)
         .map_or(Ok(defaults.other_iterations), |s| s.parse())
         .context("OTHER_ITER is a whole number of iterations, 0 to 255")?;
+    let light_others = match args.get(8).map(String::as_str) {
+        None => defaults.light_others,
+        Some("1") => true,
+        Some("0") => false,
+        Some(other) => anyhow::bail!("LIGHT is 1 or 0, not {other:?}"),
+    };
     let sequence = Sequence::open(std::path::Path::new(seq))?;
     let config = HypothesesConfig {
         count: k,
@@ -46,6 +52,7 @@ fn main() -> Result<()> {
         keep_fingers,
         sample_iterations,
         other_iterations,
+        light_others,
         likelihood: LikelihoodConfig {
             reverse_weight: reverse,
             ..defaults.likelihood

@@ -209,6 +209,102 @@ fn a_capped_frame_takes_at_most_its_iterations_and_the_own_number_returns() {
     assert_eq!(*capped.config(), own);
 }
 
+/// `track_light` is a frame without region rows and without the silhouette check: bit for bit
+/// a tracker configured so, the agreement reported as 1 and the silhouette reference left as
+/// it was; the tracker's own configuration is back afterwards, error or not.
+#[test]
+fn a_light_frame_skips_the_region_rows_and_the_check_and_leaves_the_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = Sequence::open(&common::mouse(dir.path(), 6)).unwrap();
+    let initial: Vec<f32> = seq.initial_state.iter().map(|&v| v as f32).collect();
+    let mut bare = TrackerConfig::default();
+    bare.fill.weight = 0.0;
+    bare.silhouette_grid = 0;
+    let mut configured_bare = Tracker::new(
+        seq.model.clone(),
+        &seq.cameras,
+        &initial,
+        seq.free_mask(),
+        bare,
+    )
+    .unwrap();
+    let mut light = sequence_tracker(&seq);
+    let own = *light.config();
+    assert!(own.fill.is_on() && own.silhouette_grid > 0);
+    // The first frame in full sets the reference the light frames must leave alone.
+    let first = seq.read_frame(0, 0).unwrap();
+    light.track(&[view(&first)]).unwrap();
+    configured_bare.restore(&light.memory()).unwrap();
+    let reference = light.memory().silhouette_reference;
+    assert!(reference.is_some_and(|r| r < 1.0), "{reference:?}");
+    let mut full = sequence_tracker(&seq);
+    full.restore(&light.memory()).unwrap();
+    let mut differs = false;
+    for k in 1..seq.frames {
+        let image = seq.read_frame(0, k).unwrap();
+        let a = configured_bare.track(&[view(&image)]).unwrap();
+        let b = light.track_light(0, &[view(&image)]).unwrap();
+        let c = full.track(&[view(&image)]).unwrap();
+        assert_eq!(a, b, "frame {k}");
+        assert_eq!(configured_bare.state(), light.state(), "frame {k}");
+        assert_eq!(b.silhouette_agreement, 1.0, "frame {k}");
+        assert_eq!(light.memory().silhouette_reference, reference, "frame {k}");
+        assert_eq!(*light.config(), own, "frame {k}");
+        differs |= full.state() != light.state() || c.silhouette_agreement < 1.0;
+    }
+    assert!(differs, "the region rows and the check changed nothing");
+    let small = vec![0u8; 16 * 16];
+    let wrong = FrameView::packed(&small, 16, 16).unwrap();
+    assert!(light.track_light(1, &[wrong]).is_err());
+    assert_eq!(*light.config(), own);
+}
+
+/// With `light_others`, the hypotheses other than the best are tracked light on the frames
+/// between scored ones (their agreement 1, their reference untouched) and in full on scored
+/// frames; the best always in full.
+#[test]
+fn the_others_are_tracked_light_between_scored_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = Sequence::open(&common::mouse(dir.path(), 13)).unwrap();
+    let config = HypothesesConfig {
+        count: 3,
+        spawn_per_frame: 2,
+        score_every_frames: 4,
+        light_others: true,
+        ..HypothesesConfig::default()
+    };
+    let mut bufs = buffers(&seq.cameras, &config);
+    let mut multi = MultiTracker::new(sequence_tracker(&seq), config);
+    let (mut light, mut full_best) = (0, 0);
+    for k in 0..seq.frames {
+        let image = seq.read_frame(0, k).unwrap();
+        let before: Vec<Option<f32>> = multi
+            .hypotheses()
+            .iter()
+            .map(|h| h.memory.silhouette_reference)
+            .collect();
+        let mut slices: Vec<&mut [u8]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
+        let report = multi.track(&[view(&image)], &mut slices).unwrap();
+        let h = multi.hypotheses();
+        if report.sampled > 0 {
+            // A scored frame: every candidate was tracked in full and checked.
+            assert!(
+                h.iter().all(|c| c.report.silhouette_agreement < 1.0),
+                "frame {k}"
+            );
+            continue;
+        }
+        full_best += usize::from(h[0].report.silhouette_agreement < 1.0);
+        for (other, was) in h[1..].iter().zip(&before[1..]) {
+            assert_eq!(other.report.silhouette_agreement, 1.0, "frame {k}");
+            assert_eq!(other.memory.silhouette_reference, *was, "frame {k}");
+            light += 1;
+        }
+    }
+    assert!(light > 0, "no hypothesis but the best was carried");
+    assert!(full_best > 0, "the best is checked on the frames between");
+}
+
 /// A search's refinement runs its own number of Gauss–Newton iterations
 /// ([`FinderConfig::refine_iterations`]) whatever the tracker's, and the tracker's own number
 /// is back afterwards; 0 leaves the tracker's.

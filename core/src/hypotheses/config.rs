@@ -72,6 +72,11 @@ pub struct HypothesesConfig {
     /// Gauss–Newton iterations at most for each carried hypothesis other than the best (0:
     /// the tracker's own). The best always takes the tracker's own number.
     pub other_iterations: u8,
+    /// On the frames between scored ones ([`HypothesesConfig::score_every_frames`]), track
+    /// the hypotheses other than the best without region rows and without the silhouette
+    /// check ([`Tracker::track_light`](crate::tracker::Tracker::track_light)): their reports
+    /// are not read until the next scored frame tracks them in full. Default false.
+    pub light_others: bool,
     /// Units of the state kinds.
     pub spread: Spread,
     /// How far a sample lies from the best along a weak direction (in [`Spread`] units).
@@ -159,6 +164,7 @@ impl Default for HypothesesConfig {
             keep_fingers: true,
             sample_iterations: 0,
             other_iterations: 0,
+            light_others: false,
             spread: Spread::default(),
             spawn_step: 1.0,
             merge_distance: 0.3,

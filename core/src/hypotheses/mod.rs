@@ -490,7 +490,11 @@ impl MultiTracker {
         for (index, h) in self.hypotheses.iter_mut().enumerate() {
             self.tracker.restore(&h.memory)?;
             let cap = self.config.carried_iterations(index);
-            h.report = self.tracker.track_at_most(cap, frames)?;
+            h.report = if index > 0 && self.config.light_others {
+                self.tracker.track_light(cap, frames)?
+            } else {
+                self.tracker.track_at_most(cap, frames)?
+            };
             h.memory = self.tracker.memory();
             h.age += 1;
         }

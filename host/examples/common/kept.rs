@@ -126,6 +126,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "keepf" => o.hypotheses.keep_fingers = f != 0.0,
             "si" => o.hypotheses.sample_iterations = f as u8,
             "oi" => o.hypotheses.other_iterations = f as u8,
+            "lo" => o.hypotheses.light_others = f != 0.0,
             "jumps" => o.hypotheses.jumps_per_frame = f as u8,
             "jturn" => o.hypotheses.jump_min_turn_rad = f,
             "jpx" => o.hypotheses.jump_max_moved_px = f,
