@@ -46,11 +46,6 @@ pub struct FeatureConfig {
     /// Search window along each slice and beyond each tip (px, at most [`MAX_WINDOW`]), in
     /// a frame's first iteration.
     pub window_px: u8,
-    /// Search window beyond each tip (px, at most [`MAX_WINDOW`]), in a frame's first
-    /// iteration; 0 (the default): [`FeatureConfig::window_px`]. A knuckle tip moves further
-    /// in the image than a link's sides when its finger bends, so it may need more reach than
-    /// the slices ([`FeatureConfig::tip_window`]).
-    pub tip_window_px: u8,
     /// Coarse to fine: in a frame's later iterations the tracker narrows each link's window
     /// to what its last search needed, [`LinkFeatures::reach_px`] plus this margin on each
     /// side (px); infinite keeps `window_px` throughout.
@@ -101,7 +96,6 @@ impl Default for FeatureConfig {
         FeatureConfig {
             slices_per_link: 5,
             window_px: 20,
-            tip_window_px: 0,
             refine_margin_px: 1.5,
             min_contrast: 4.0,
             span: [0.15, 0.85],
@@ -122,16 +116,6 @@ impl FeatureConfig {
     /// `knuckle_tips`) a knuckle where the outline ends.
     pub fn searches_tip(&self, link: &ProjectedLink) -> bool {
         self.tips && (link.distal || (self.knuckle_tips && link.knuckle_ends))
-    }
-
-    /// The tip windows' length (px): [`FeatureConfig::tip_window_px`], or
-    /// [`FeatureConfig::window_px`] when that is 0.
-    pub fn tip_window(&self) -> u8 {
-        if self.tip_window_px == 0 {
-            self.window_px
-        } else {
-            self.tip_window_px
-        }
     }
 
     /// `tan(max_edge_angle_rad)`, or `None` when every edge is kept.
@@ -483,8 +467,8 @@ fn search_link<W: FnMut(&SearchWindow)>(
     let Some(link) = view.links.get(index) else {
         return;
     };
-    let slice_window = usize::from(config.window_px).clamp(MIN_WINDOW_SAMPLES, MAX_WINDOW);
-    let tip_window = usize::from(config.tip_window()).clamp(MIN_WINDOW_SAMPLES, MAX_WINDOW);
+    let window = usize::from(config.window_px).clamp(MIN_WINDOW_SAMPLES, MAX_WINDOW);
+    let half = (window - 1) as f32 * 0.5;
     let (dir, normal) = link.axis_frame();
     let slices = usize::from(config.slices_per_link).clamp(1, MAX_SLICES_PER_LINK);
     let mut profile = [0.0f32; MAX_WINDOW];
@@ -520,8 +504,6 @@ fn search_link<W: FnMut(&SearchWindow)>(
                       window_bit: u32,
                       out: &mut LinkFeatures| {
         let tip = window_bit == RefusedWindows::TIP;
-        let window = if tip { tip_window } else { slice_window };
-        let half = (window - 1) as f32 * 0.5;
         let mut watched = |outcome| {
             watch(&SearchWindow {
                 start: centre - outward * half,

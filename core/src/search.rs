@@ -143,9 +143,6 @@ fn narrowed(config: &FeatureConfig, refine: bool, reach_px: f32) -> FeatureConfi
         if need < f32::from(features.window_px) {
             features.window_px = libm::ceilf(need) as u8;
         }
-        if features.tip_window_px != 0 && need < f32::from(features.tip_window_px) {
-            features.tip_window_px = libm::ceilf(need) as u8;
-        }
     }
     features
 }

@@ -103,40 +103,6 @@ fn watched_search_finds_the_same_features_and_reports_every_window() {
     assert!(found_any > 20, "{found_any} edges found");
 }
 
-/// A tip window takes its own length when `tip_window_px` is set (the slices keep
-/// `window_px`), and the slices' length when it is 0.
-#[test]
-fn tip_windows_take_their_own_length() {
-    let model = Model::hand().unwrap();
-    let camera = camera();
-    let poses = Poses::compute(&model, &pose()).unwrap();
-    let mut view = ProjectedModel::new();
-    view.update(&model, &poses, &camera, 6.0);
-    let pixels = paint(&view, &camera);
-    let frame = FrameView::packed(&pixels, 640, 480).unwrap();
-    let mut config = FeatureConfig::default();
-    config.window_px = 16;
-    for tip_window_px in [0u8, 24] {
-        config.tip_window_px = tip_window_px;
-        let expected_tip = if tip_window_px == 0 { 16 } else { 24 };
-        assert_eq!(config.tip_window(), expected_tip);
-        let mut tips = 0;
-        for index in 0..view.links.len() {
-            let mut out = LinkFeatures::default();
-            let mut windows: Vec<SearchWindow> = Vec::new();
-            find_link_features_watched(&view, &camera, &frame, index, &config, &mut out, |w| {
-                windows.push(*w)
-            });
-            for w in &windows {
-                let expected = if w.tip { expected_tip } else { 16 };
-                assert_eq!(w.samples, expected, "link {index}, tip {}", w.tip);
-            }
-            tips += windows.iter().filter(|w| w.tip).count();
-        }
-        assert!(tips >= 5, "{tips} tip windows");
-    }
-}
-
 /// Edges and tips found.
 fn found(f: &LinkFeatures) -> usize {
     f.edges.len() + usize::from(f.tip.is_some())
