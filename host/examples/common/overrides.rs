@@ -5,6 +5,10 @@ use digiteyes_core::tracker::TrackerConfig;
 
 #[derive(clap::Args, Debug, Clone, Copy, Default)]
 pub struct TrackerOverrides {
+    /// The slice search's window in a frame's first iteration (px; default: the tracker's):
+    /// to scan seeds under another window before it is the default.
+    #[arg(long)]
+    pub window_px: Option<u8>,
     /// The slice search's outermost-edge share (0: the strongest edge; default: the
     /// tracker's).
     #[arg(long)]
@@ -40,6 +44,7 @@ impl TrackerOverrides {
     /// `config` with every setting given here in place of its own.
     pub fn apply(&self, config: &mut TrackerConfig) {
         let (features, fill) = (&mut config.features, &mut config.fill);
+        features.window_px = self.window_px.unwrap_or(features.window_px);
         features.outermost_share = self.outermost_share.unwrap_or(features.outermost_share);
         features.knuckle_tips = self.knuckle_tips.unwrap_or(features.knuckle_tips);
         fill.weight = self.fill_weight.unwrap_or(fill.weight);
