@@ -15,6 +15,16 @@ use digiteyes_host::sequence::Sequence;
 use digiteyes_host::track::sequence_tracker;
 use digiteyes_host::TrackerConfig;
 
+/// A 1 / 0 argument named `name`; left out, `default`.
+fn switch(arg: Option<&String>, name: &str, default: bool) -> Result<bool> {
+    match arg.map(String::as_str) {
+        None => Ok(default),
+        Some("1") => Ok(true),
+        Some("0") => Ok(false),
+        Some(other) => anyhow::bail!("{name} is 1 or 0, not {other:?}"),
+    }
+}
+
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let seq = args.first().context("SEQ K FRAMES")?;
@@ -25,12 +35,7 @@ fn main() -> Result<()> {
     let reverse: f32 = args
         .get(4)
         .map_or(Ok(defaults.likelihood.reverse_weight), |s| s.parse())?;
-    let keep_fingers = match args.get(5).map(String::as_str) {
-        None => defaults.keep_fingers,
-        Some("1") => true,
-        Some("0") => false,
-        Some(other) => anyhow::bail!("KEEP is 1 or 0, not {other:?}"),
-    };
+    let keep_fingers = switch(args.get(5), "KEEP", defaults.keep_fingers)?;
     let sample_iterations: u8 = args
         .get(6)
         .map_or(Ok(defaults.sample_iterations), |s| s.parse())
@@ -39,12 +44,7 @@ fn main() -> Result<()> {
         .get(7)
         .map_or(Ok(defaults.other_iterations), |s| s.parse())
         .context("OTHER_ITER is a whole number of iterations, 0 to 255")?;
-    let light_others = match args.get(8).map(String::as_str) {
-        None => defaults.light_others,
-        Some("1") => true,
-        Some("0") => false,
-        Some(other) => anyhow::bail!("LIGHT is 1 or 0, not {other:?}"),
-    };
+    let light_others = switch(args.get(8), "LIGHT", defaults.light_others)?;
     let sequence = Sequence::open(std::path::Path::new(seq))?;
     let config = HypothesesConfig {
         count: k,
