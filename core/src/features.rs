@@ -95,7 +95,7 @@ impl Default for FeatureConfig {
     fn default() -> Self {
         FeatureConfig {
             slices_per_link: 5,
-            window_px: 20,
+            window_px: 16,
             refine_margin_px: 1.5,
             min_contrast: 4.0,
             span: [0.15, 0.85],

@@ -147,7 +147,10 @@ fn on_and_off() -> (FeatureConfig, FeatureConfig) {
 
 #[test]
 fn windows_refused_earlier_in_the_frame_stay_refused() {
-    let (camera, pixels, view) = off_prediction(0.3);
+    // Every joint 0.25 rad off: 7 windows refused under the 16 px slice window (9 under a
+    // 20 px one). At 0.3 rad, this test's offset until the window narrowed, the 16 px window
+    // reaches fewer crossed edges (5 refused).
+    let (camera, pixels, view) = off_prediction(0.25);
     let frame = FrameView::packed(&pixels, 640, 480).unwrap();
     let (on, off) = on_and_off();
     let mut everything = RefusedWindows::NONE;
@@ -192,5 +195,6 @@ fn windows_refused_earlier_in_the_frame_stay_refused() {
         search(&off, &mut unrefused);
         assert_eq!(unrefused, RefusedWindows::NONE, "link {index}");
     }
+    println!("{refused_anywhere} windows refused");
     assert!(refused_anywhere > 5, "{refused_anywhere} windows refused");
 }

@@ -382,7 +382,7 @@ fn leaves_are_refined_under_the_searchs_robust_weight_not_the_trackers() {
 fn leaves_are_refined_without_the_trackers_edge_direction_test() {
     // A leaf starts turned from the hand, so the image's edges run at an angle to the ones
     // it predicts: under the tracker's edge-direction test (30 degrees by default) its
-    // refinement refuses the edges that would pull it in, and `random-stereo` seed 142 is
+    // refinement refuses the edges that would pull it in, and `random-stereo` seed 112 is
     // not acquired. Leaves are refined with the test off
     // (`FinderConfig::leaf_max_edge_angle_rad`). (A seed that shows it, not a sweep's
     // verdict: at 5 px, with the tracker's outermost edge, 23 of the 40 stereo seeds 101-140
@@ -390,9 +390,13 @@ fn leaves_are_refined_without_the_trackers_edge_direction_test() {
     // docs/recovery.md. The seed was 817 before the lighting was varied, 803 before the
     // outermost edge, 108 until the search's budget of 100 a frame, under which 108 is
     // acquired either way, and 124 until sines and cosines were computed in single precision
-    // (stop 54), which moved its run by rounding. Of the even seeds 102-160, 142 and 146 are
+    // (stop 54), which moved its run by rounding. Of the even seeds 102-160, 142 and 146 were
     // then acquired only with the leaves' test off, 116 and 138 only with it on, 18 either
-    // way: a mechanism shown on one seed, not a verdict.) The tracker runs without its region rows here, and without the free
+    // way. Since the slice window narrowed to 16 px (stop 72) 142 is acquired with neither;
+    // of the stereo seeds 101-500 (`acquire_probe --seeds 101..=500 --rigs stereo
+    // --limit-px 10 --fill-weight 0 --settle-frames 0`, with and without
+    // `--leaf-angle-deg 30`) 25 are acquired only with the leaves' test off, 112 among them,
+    // 21 only with it on, 250 either way: a mechanism shown on one seed, not a verdict.) The tracker runs without its region rows here, and without the free
     // settling after an acquisition (`settle_frames` 0): both pull the strict leaves in as
     // well, which hides the edge test's effect.
     let dir = tempfile::tempdir().unwrap();
@@ -407,21 +411,21 @@ fn leaves_are_refined_without_the_trackers_edge_direction_test() {
         angle < finder.leaf_max_edge_angle_rad,
         "the test is on by default"
     );
-    let (good, line) = acquisition(dir.path(), "random-stereo", 142, tracker, finder);
-    println!("random-stereo 142, leaves without the test: {line}");
+    let (good, line) = acquisition(dir.path(), "random-stereo", 112, tracker, finder);
+    println!("random-stereo 112, leaves without the test: {line}");
     assert!(
         acquired_before(&good, 30).is_some(),
-        "random-stereo 142 not acquired before frame 30: {line}"
+        "random-stereo 112 not acquired before frame 30: {line}"
     );
     let strict = FinderConfig {
         leaf_max_edge_angle_rad: angle,
         ..finder
     };
-    let (good, line) = acquisition(dir.path(), "random-stereo", 142, tracker, strict);
-    println!("random-stereo 142, leaves under the tracker's test: {line}");
+    let (good, line) = acquisition(dir.path(), "random-stereo", 112, tracker, strict);
+    println!("random-stereo 112, leaves under the tracker's test: {line}");
     assert!(
         acquired_before(&good, 30).is_none(),
-        "random-stereo 142 acquired with leaves under the tracker's edge test: {line}"
+        "random-stereo 112 acquired with leaves under the tracker's edge test: {line}"
     );
 }
 

@@ -280,12 +280,15 @@ fn claimed_tip_errors(
 #[test]
 fn the_confirm_phase_keeps_the_leaf_better_over_its_frames_not_on_the_last() {
     let dir = tempfile::tempdir().unwrap();
-    // A seed of the sweep this shows on (found among the even seeds 2032-2430 under the
-    // search's budget of 100 a frame; until then it was seed 1751, which both rankings now
-    // hold right from frame 10): after the acquisition, ranked by the frame under the switch
-    // margin of 0.01 the output stays on a leaf 11-12 px off through frame 15; ranked by the
-    // running mean it moves to a right one (1.4-1.7 px) from frame 7.
-    let sequence = common::seeded(dir.path(), "random-stereo", 2046, 16);
+    // A seed of the sweep this shows on: after the acquisition, ranked by the frame under the
+    // switch margin of 0.01 the output stays on a leaf 15-17 px off through frame 15; ranked
+    // by the running mean it is 6.6-7.0 px off. Found by `scan_seeds_for_the_confirm_phase_
+    // ranking` below under stop 72's defaults (the slice window at 16 px): of seeds
+    // 2432-3300, 2716, 2787, 2870 and 3130 pass this test's bars; 3130 by the widest margin.
+    // (Seed 2046, found among the even seeds 2032-2430 under the search's budget of 100 a
+    // frame and a 20 px window, is held right when ranked by the frame too since, 1.1-1.8
+    // px; before it, 1751.)
+    let sequence = common::seeded(dir.path(), "random-stereo", 3130, 16);
     let ranked_by_the_frame = FinderConfig {
         confirm_switch_margin: 0.01,
         confirm_score_memory: 0.0,
@@ -296,4 +299,33 @@ fn the_confirm_phase_keeps_the_leaf_better_over_its_frames_not_on_the_last() {
     println!("frames 12-15, tip px: by the frame {before:?}, by the running mean {now:?}");
     assert!(before.iter().all(|&e| e > 10.0), "{before:?}");
     assert!(now.iter().all(|&e| e < 10.0), "{now:?}");
+}
+
+/// A scan for the seed of the test above, by its own bars, for when a default changes
+/// (`docs/mechanism-seeds.md`): `DIGITEYES_SCAN_SEEDS=2032..=2430 cargo test --release -p
+/// digiteyes-tests --test acquire_multi scan -- --ignored --nocapture` prints each seed's
+/// claimed tip errors on frames 12-15 under both rankings and the seeds that pass.
+#[test]
+#[ignore = "a scan of minutes: DIGITEYES_SCAN_SEEDS=A..=B"]
+fn scan_seeds_for_the_confirm_phase_ranking() {
+    let ranked_by_the_frame = FinderConfig {
+        confirm_switch_margin: 0.01,
+        confirm_score_memory: 0.0,
+        ..FinderConfig::default()
+    };
+    let mut passing = Vec::new();
+    for seed in common::seeds_to_scan() {
+        let dir = tempfile::tempdir().unwrap();
+        let sequence = common::seeded(dir.path(), "random-stereo", seed, 16);
+        let before = claimed_tip_errors(&sequence, ranked_by_the_frame, 12..16);
+        let now = claimed_tip_errors(&sequence, FinderConfig::default(), 12..16);
+        let shows = before.iter().all(|&e| e > 10.0) && now.iter().all(|&e| e < 10.0);
+        println!(
+            "seed {seed}: by the frame {before:?}, by the running mean {now:?}, shows {shows}"
+        );
+        if shows {
+            passing.push(seed);
+        }
+    }
+    println!("{} seeds pass: {passing:?}", passing.len());
 }

@@ -12,6 +12,8 @@ use digiteyes_host::sequence::read_states;
 use digiteyes_host::track::{track_sequence_opts, TrackOptions};
 use digiteyes_host::{evaluate, render_scenario, RenderOptions, TrackerConfig};
 
+mod common;
+
 fn never() -> WatchConfig {
     WatchConfig {
         every_frames: 0,
@@ -61,20 +63,22 @@ fn a_right_track_of_another_renderer_is_never_flagged() {
     assert!(lost.iter().all(|&l| !l), "right frames flagged: {lost:?}");
 }
 
-#[test]
-fn a_track_the_image_no_longer_supports_is_flagged() {
-    // Seed 76 (a stereo rig of the robustness sweep, 640x480), tracked without the palm's
-    // outline edges: from frame ~59 the track settles on wrong fingers while the tracker's
-    // own flag stays down. The watch removes a third or more of those frames (measured:
-    // 32 -> 17, whether a check falls due every 32 frames, as at 640x480 before stop 61, or
-    // every 8, as at every size since), not all. (With the palm edges,
-    // the default, this seed is tracked right to frame 90 and no sweep seed offers a wrong
-    // track the watch catches: docs/robustness.md.) Rendered under the fixed light this case
-    // was found under, not the lighting the sweep now draws for the seed.
+/// What the watch did on one seed of [`watch_case`]: frames claimed more than 20 px wrong,
+/// and right frames flagged, with the watch and without it.
+struct WatchCase {
+    claimed_wrong_watched: usize,
+    claimed_wrong_plain: usize,
+    right_flagged_watched: usize,
+    right_flagged_plain: usize,
+}
+
+/// `random-stereo` `seed`, 90 frames at 640x480 under the fixed light, tracked with the
+/// watch and without it by the tracker that loses it (the set-up the test below explains).
+fn watch_case(seed: u64) -> WatchCase {
     let dir = tempfile::tempdir().unwrap();
     let seq = dir.path().join("seq");
     let options = RenderOptions {
-        seed: 76,
+        seed,
         frames: Some(90),
         supersample: 2,
         lighting: Some(Lighting::default()),
@@ -110,10 +114,30 @@ fn a_track_the_image_no_longer_supports_is_flagged() {
             .filter(|(l, t)| **l && **t <= wrong)
             .count()
     };
-    let (with, without) = (
-        claimed_wrong(&watched, &tips),
-        claimed_wrong(&plain, &plain_tips),
-    );
+    WatchCase {
+        claimed_wrong_watched: claimed_wrong(&watched, &tips),
+        claimed_wrong_plain: claimed_wrong(&plain, &plain_tips),
+        right_flagged_watched: right_flagged(&watched, &tips),
+        right_flagged_plain: right_flagged(&plain, &plain_tips),
+    }
+}
+
+#[test]
+fn a_track_the_image_no_longer_supports_is_flagged() {
+    // Seed 115 (a stereo rig of the robustness sweep, 640x480), tracked without the palm's
+    // outline edges and the four mechanisms below: the track settles on wrong fingers while
+    // the tracker's own flag stays down. The watch removes a third or more of those frames
+    // (measured: 72 -> 31), not all. Found by `scan_seeds_for_the_watch` (below) on seeds
+    // 1-120 under stop 72's defaults (the slice window at 16 px): 77 and 115 pass; of the
+    // 27 other seeds claimed wrong on a frame or more, the watch cuts two by a third but
+    // flags right frames there too (5, 101), and the rest by less. (Seed
+    // 76, this test's until the window narrowed, is tracked right to frame 90 since; under
+    // the 20 px window it was claimed wrong on 32 frames, 17 with the watch.) (With the palm
+    // edges, the default, no sweep seed offered a wrong track the watch catches:
+    // docs/robustness.md.) Rendered under the fixed light this case was found under, not
+    // the lighting the sweep now draws for the seed.
+    let case = watch_case(115);
+    let (with, without) = (case.claimed_wrong_watched, case.claimed_wrong_plain);
     assert!(
         without >= 10,
         "the plain track is claimed while wrong: {without} frames"
@@ -123,8 +147,35 @@ fn a_track_the_image_no_longer_supports_is_flagged() {
         "frames claimed while wrong: {with} with the watch, {without} without"
     );
     assert_eq!(
-        right_flagged(&watched, &tips),
-        right_flagged(&plain, &plain_tips),
+        case.right_flagged_watched, case.right_flagged_plain,
         "the watch flagged right frames"
     );
+}
+
+/// A scan for the seed of the test above, by its own bars, for when a default changes
+/// (`docs/mechanism-seeds.md`): `DIGITEYES_SCAN_SEEDS=1..=100 cargo test --release -p
+/// digiteyes-tests --test watch scan -- --ignored --nocapture` prints each seed's frames
+/// claimed wrong and right frames flagged, with the watch and without.
+#[test]
+#[ignore = "a scan of minutes: DIGITEYES_SCAN_SEEDS=A..=B"]
+fn scan_seeds_for_the_watch() {
+    let mut passing = Vec::new();
+    for seed in common::seeds_to_scan() {
+        let c = watch_case(seed);
+        let shows = c.claimed_wrong_plain >= 10
+            && c.claimed_wrong_watched * 3 <= c.claimed_wrong_plain * 2
+            && c.right_flagged_watched == c.right_flagged_plain;
+        println!(
+            "seed {seed}: claimed wrong {} watched, {} plain; right flagged {} watched, {} \
+             plain; shows {shows}",
+            c.claimed_wrong_watched,
+            c.claimed_wrong_plain,
+            c.right_flagged_watched,
+            c.right_flagged_plain
+        );
+        if shows {
+            passing.push(seed);
+        }
+    }
+    println!("{} seeds pass: {passing:?}", passing.len());
 }

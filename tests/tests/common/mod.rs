@@ -50,3 +50,17 @@ pub fn skip(what: &str, reason: &str) {
     use std::io::Write;
     let _ = writeln!(std::io::stderr(), "\n{message}\n");
 }
+
+/// The seeds a mechanism test's scan runs (`docs/mechanism-seeds.md`), named by
+/// `DIGITEYES_SCAN_SEEDS` (`A..=B`, `A..B` or one seed).
+pub fn seeds_to_scan() -> Vec<u64> {
+    let text = std::env::var("DIGITEYES_SCAN_SEEDS").expect("DIGITEYES_SCAN_SEEDS=A..=B");
+    let number = |s: &str| s.trim().parse::<u64>().expect("a seed is a whole number");
+    if let Some((a, b)) = text.split_once("..=") {
+        (number(a)..=number(b)).collect()
+    } else if let Some((a, b)) = text.split_once("..") {
+        (number(a)..number(b)).collect()
+    } else {
+        vec![number(&text)]
+    }
+}
