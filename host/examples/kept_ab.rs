@@ -2,7 +2,8 @@
 //! seed with each variant and prints the track-life distribution per group. A variant is
 //! `default` or `key=value` overrides joined by `+` (keys: `pj`, `pt`, `pq` the prior's
 //! weights, `sj`, `st`, `sq` the conditioning; `iters` (the tracker's Gauss–Newton iterations),
-//! `liters` (a search leaf's or local start's), `predict`, `window`, `slices`, `palm`,
+//! `liters` (a search leaf's or local start's), `predict`, `window`, `margin` (the narrowed
+//! windows' margin, px), `contrast` (the smallest edge), `slices`, `palm`,
 //! `palmw`, `tipw`, `fvf`, `outer`, `knuckle` (0: no knuckle tips), `bounds` (0: the plain
 //! step); `angle` the edge-direction limit in degrees (90: off); `huber`, `tukey` the robust
 //! kernel's px; `k`, `s`, `spawn`, `step`, `smem`, `switch` the hypotheses (their count, scoring

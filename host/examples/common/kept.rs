@@ -79,6 +79,8 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "liters" => o.finder.refine_iterations = f as u8,
             "predict" => c.predict = f != 0.0,
             "window" => c.features.window_px = f as u8,
+            "margin" => c.features.refine_margin_px = f,
+            "contrast" => c.features.min_contrast = f,
             "slices" => c.features.slices_per_link = f as u8,
             "palm" => c.features.palm_edges = f != 0.0,
             "angle" => c.features.max_edge_angle_rad = f.to_radians(),
