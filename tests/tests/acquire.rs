@@ -396,9 +396,10 @@ fn leaves_are_refined_without_the_trackers_edge_direction_test() {
     // of the stereo seeds 101-500 (`acquire_probe --seeds 101..=500 --rigs stereo
     // --limit-px 10 --fill-weight 0 --settle-frames 0`, with and without
     // `--leaf-angle-deg 30`) 25 are acquired only with the leaves' test off, 112 among them,
-    // 21 only with it on, 250 either way: a mechanism shown on one seed, not a verdict.) The tracker runs without its region rows here, and without the free
-    // settling after an acquisition (`settle_frames` 0): both pull the strict leaves in as
-    // well, which hides the edge test's effect.
+    // 21 only with it on, 250 either way: a mechanism shown on one seed, not a verdict.)
+    // The tracker runs without its region rows here, and without the free settling after
+    // an acquisition (`settle_frames` 0): both pull the strict leaves in as well, which
+    // hides the edge test's effect.
     let dir = tempfile::tempdir().unwrap();
     let mut tracker = TrackerConfig::default();
     tracker.fill = FillConfig::OFF;

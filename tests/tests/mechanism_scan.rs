@@ -10,7 +10,9 @@
 //!
 //! and it prints, for each seed, the tests whose bars it passes; the summary lists every
 //! passing seed per test. `DIGITEYES_SCAN_TESTS=settle,pursue` scans for those tests only
-//! (of `pursue`, `settle`, `confirm_depth`, `rival`). Confirm a candidate in the test itself before moving its seed.
+//! (of `pursue`, `settle`, `confirm_depth`, `rival`). Confirm a candidate in the test itself
+//! before moving its seed. The bars are the tests' own, written again here as predicates:
+//! a test that changes its bars changes them here too.
 
 use digiteyes_core::acquire::FinderConfig;
 
