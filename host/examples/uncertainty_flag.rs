@@ -31,6 +31,7 @@ use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::nalgebra::{SMatrix, Vector3};
 use digiteyes_host::bench::robustness::{judge_frame, TRULY_LOST_TIP_PX_AT_640};
 use digiteyes_host::eval::evaluate;
+use digiteyes_host::eval::stats::percentile;
 use digiteyes_host::sequence::{read_states, Sequence};
 use digiteyes_host::sequence_tracker;
 
@@ -201,8 +202,8 @@ fn main() -> Result<()> {
                 auc(&lost, &right),
                 lost.len(),
                 right.len(),
-                median(&lost),
-                median(&right)
+                percentile(&lost, 0.5),
+                percentile(&right, 0.5)
             );
             let deciles = |v: &[f64]| {
                 let mut v = v.to_vec();
@@ -252,12 +253,6 @@ fn ratio(a: usize, b: usize) -> f64 {
     } else {
         a as f64 / b as f64
     }
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut v = v.to_vec();
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// The probability that a lost frame's signal exceeds a right one's (ties count half).
