@@ -28,6 +28,8 @@ use std::path::PathBuf;
 
 #[path = "common/kept.rs"]
 mod kept;
+#[path = "common/roc.rs"]
+mod roc;
 
 #[derive(Parser)]
 struct Args {
@@ -179,19 +181,7 @@ fn summarise(name: &str, seeds: &[SeedChecks], window: usize) {
         )
     };
     // The area under the curve: the chance a wrong check's error exceeds a right one's.
-    let mut over = 0.0;
-    for &a in &wrong {
-        for &b in &right {
-            over += if a > b {
-                1.0
-            } else if a == b {
-                0.5
-            } else {
-                0.0
-            };
-        }
-    }
-    let auc = over / (wrong.len() * right.len()) as f64;
+    let auc = roc::auc(&wrong, &right);
     println!(
         "{name}: {} seeds; checks truly lost {} (fb px {}), right {} (fb px {}); AUC {auc:.3}",
         seeds.len(),

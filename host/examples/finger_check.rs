@@ -14,15 +14,22 @@
 //! the finger's true joints (the rest of the hand as kept) over the kept ones when the finger
 //! is wrong: what a per-finger re-acquisition scored this way could do.
 //!
+//! With `--drift`, the same scores as a lost signal: each finger's chamfer and bright share
+//! against its own level on the seed's first `--reference` scored frames, the worst finger's
+//! change per frame, and the AUC for the frames truly lost (as the benchmark judges them)
+//! against the right ones, among the frames the lost flag leaves unflagged.
+//!
 //! ```text
 //! digiteyes bench robustness --seeds 60 --frames 200 --keep /tmp/keep
-//! cargo run --release -p digiteyes-host --example finger_check -- /tmp/keep
+//! cargo run --release -p digiteyes-host --example finger_check -- /tmp/keep [--drift]
 //! ```
 
 use std::path::{Path, PathBuf};
 
 #[path = "common/kept.rs"]
 mod kept;
+#[path = "common/roc.rs"]
+mod roc;
 
 use anyhow::Result;
 use clap::Parser;
@@ -36,7 +43,8 @@ use digiteyes_core::nalgebra::Vector2;
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_core::silhouette::{covers, hand_bounds};
 use digiteyes_core::visibility::{candidates, cover_among, Cover};
-use digiteyes_host::eval::{reprojection_error, stats};
+use digiteyes_host::bench::robustness::{judge_frame, TRULY_LOST_TIP_PX_AT_640};
+use digiteyes_host::eval::{evaluate, reprojection_error, stats};
 use digiteyes_host::sequence::{read_states, Sequence};
 
 #[derive(Parser)]
@@ -49,6 +57,14 @@ struct Args {
     /// Only frames where all fingers are right, or one is wrong and the rest within 5 px.
     #[arg(long)]
     single: bool,
+    /// Instead: each finger's scores against its own level on the seed's first
+    /// `--reference` scored frames (the track starts at the truth), the worst finger's change
+    /// per frame as a lost signal, judged as the benchmark judges frames.
+    #[arg(long)]
+    drift: bool,
+    /// With `--drift`: scored frames that set each finger's own level.
+    #[arg(long, default_value_t = 5)]
+    reference: usize,
 }
 
 /// Per finger: bright share and chamfer; and the unexplained share, of one camera's view.
@@ -250,8 +266,115 @@ fn open(dir: &Path) -> Result<Kept> {
     Ok((sequence, truth, kept))
 }
 
+/// One camera's edge maps of `frames`, in `buffers`.
+fn edge_maps<'a>(
+    buffers: &'a mut [Vec<u8>],
+    frames: &[FrameView<'_>],
+    config: &LikelihoodConfig,
+) -> Result<Vec<EdgeMap<'a>>> {
+    buffers
+        .iter_mut()
+        .zip(frames)
+        .map(|(b, f)| EdgeMap::build(b, f, config).map_err(|e| anyhow::anyhow!("{e}")))
+        .collect()
+}
+
+fn edge_buffers(frames: &[FrameView<'_>], config: &LikelihoodConfig) -> Vec<Vec<u8>> {
+    frames
+        .iter()
+        .map(|f| vec![0u8; EdgeMap::bytes_needed(f.width(), f.height(), config.stride_px)])
+        .collect()
+}
+
+/// `--drift`: per group, the AUC of the worst finger's change in chamfer (px) and in bright
+/// share since the seed's first scored frames, and of the worst finger's chamfer itself,
+/// for the frames truly lost against the right ones, among the frames the flag leaves.
+fn drift(args: &Args) -> Result<()> {
+    let config = LikelihoodConfig::default();
+    // Per group: (signal chamfer change, bright drop, raw chamfer, truly lost).
+    let mut groups: [Vec<(f64, f64, f64, bool)>; 2] = [Vec::new(), Vec::new()];
+    for dir in kept::seed_dirs(&args.dir)? {
+        let seed = kept::seed_of(&dir);
+        let (seq, truth, kept_states) = open(&dir)?;
+        let states_path = dir.join("states.csv");
+        let table = read_states(&states_path, seq.n_states())?;
+        let report = evaluate(&dir, &states_path)?;
+        let lost = table.extra("lost").unwrap_or_default();
+        let width = seq.cameras.first().map_or(640, |c| c.width);
+        let limit = TRULY_LOST_TIP_PX_AT_640 * f64::from(width) / 640.0;
+        let model = &seq.model;
+        let fingers = Fingers::of(model);
+        let n = fingers.count();
+        let mut history: Vec<Vec<(f32, f32)>> = vec![Vec::new(); n];
+        let group = &mut groups[usize::from(seed.is_multiple_of(2))];
+        for k in (1..truth.len().min(kept_states.len())).step_by(args.every.max(1)) {
+            let images = kept::read_instant(&seq, k)?;
+            let frames = kept::views(&images)?;
+            let mut buffers = edge_buffers(&frames, &config);
+            let edges = edge_maps(&mut buffers, &frames, &config)?;
+            let rig = Rig {
+                model,
+                fingers: &fingers,
+                cameras: &seq.cameras,
+                frames: &frames,
+                edges: &edges,
+                config: &config,
+            };
+            let Some((bright, chamfer, _)) = score_state(&rig, &kept_states[k]) else {
+                continue;
+            };
+            let (mut worst_change, mut worst_drop, mut worst_raw) = (0.0f64, 0.0f64, 0.0f64);
+            let mut referenced = true;
+            for f in 0..n {
+                let level = |h: &[(f32, f32)], pick: fn(&(f32, f32)) -> f32| {
+                    let v: Vec<f64> = h.iter().map(|x| f64::from(pick(x))).collect();
+                    stats::percentile(&v, 0.5)
+                };
+                if history[f].len() < args.reference {
+                    history[f].push((chamfer[f], bright[f]));
+                    referenced = false;
+                    continue;
+                }
+                let base = &history[f][..args.reference];
+                worst_change = worst_change.max(f64::from(chamfer[f]) - level(base, |x| x.0));
+                worst_drop = worst_drop.max(level(base, |x| x.1) - f64::from(bright[f]));
+                worst_raw = worst_raw.max(f64::from(chamfer[f]));
+            }
+            let flagged = lost.get(k).is_some_and(|&v| v != 0.0);
+            if !referenced || flagged {
+                continue;
+            }
+            let estimate: Vec<f64> = table.rows[k].clone();
+            let true_state: Vec<f64> = truth[k].iter().map(|&v| f64::from(v)).collect();
+            let (_, truly) = judge_frame(&estimate, &true_state, &report, k, limit);
+            group.push((worst_change, worst_drop, worst_raw, truly));
+        }
+        eprintln!("{}", dir.display());
+    }
+    for (name, frames) in ["mono", "stereo"].iter().zip(&groups) {
+        let split = |pick: fn(&(f64, f64, f64, bool)) -> f64| {
+            let lost: Vec<f64> = frames.iter().filter(|f| f.3).map(pick).collect();
+            let right: Vec<f64> = frames.iter().filter(|f| !f.3).map(pick).collect();
+            roc::auc(&lost, &right)
+        };
+        let lost_count = frames.iter().filter(|f| f.3).count();
+        println!(
+            "{name}: {} unflagged frames scored, {lost_count} truly lost; AUC: chamfer change {:.3}, \
+             bright drop {:.3}, chamfer itself {:.3}",
+            frames.len(),
+            split(|f| f.0),
+            split(|f| f.1),
+            split(|f| f.2)
+        );
+    }
+    Ok(())
+}
+
 fn main() -> Result<()> {
     let args = Args::parse();
+    if args.drift {
+        return drift(&args);
+    }
     let dirs = kept::seed_dirs(&args.dir)?;
     let config = LikelihoodConfig::default();
     let (mut bright_right, mut bright_wrong) = (Vec::new(), Vec::new());
@@ -271,15 +394,8 @@ fn main() -> Result<()> {
         for k in (1..truth.len().min(kept.len())).step_by(args.every.max(1)) {
             let images = kept::read_instant(&seq, k)?;
             let frames = kept::views(&images)?;
-            let mut buffers: Vec<Vec<u8>> = frames
-                .iter()
-                .map(|f| vec![0u8; EdgeMap::bytes_needed(f.width(), f.height(), config.stride_px)])
-                .collect();
-            let edges = buffers
-                .iter_mut()
-                .zip(&frames)
-                .map(|(b, f)| EdgeMap::build(b, f, &config).map_err(|e| anyhow::anyhow!("{e}")))
-                .collect::<Result<Vec<_>>>()?;
+            let mut buffers = edge_buffers(&frames, &config);
+            let edges = edge_maps(&mut buffers, &frames, &config)?;
             let rig = Rig {
                 model,
                 fingers: &fingers,

@@ -44,6 +44,8 @@ type Jac = SMatrix<f64, NR, NS>;
 
 #[path = "common/kept.rs"]
 mod kept;
+#[path = "common/roc.rs"]
+mod roc;
 
 #[derive(Parser)]
 struct Args {
@@ -199,7 +201,7 @@ fn main() -> Result<()> {
             let right: Vec<f64> = unflagged.iter().filter(|u| !u.1).map(|u| u.0).collect();
             println!(
                 "  q×{q}, σ {s} px: AUC {:.3} on {} unflagged lost / {} right; median signal lost {:.1} px, right {:.1} px",
-                auc(&lost, &right),
+                roc::auc(&lost, &right),
                 lost.len(),
                 right.len(),
                 percentile(&lost, 0.5),
@@ -253,33 +255,6 @@ fn ratio(a: usize, b: usize) -> f64 {
     } else {
         a as f64 / b as f64
     }
-}
-
-/// The probability that a lost frame's signal exceeds a right one's (ties count half).
-fn auc(lost: &[f64], right: &[f64]) -> f64 {
-    if lost.is_empty() || right.is_empty() {
-        return f64::NAN;
-    }
-    let mut all: Vec<(f64, bool)> = lost
-        .iter()
-        .map(|&v| (v, true))
-        .chain(right.iter().map(|&v| (v, false)))
-        .collect();
-    all.sort_by(|a, b| a.0.total_cmp(&b.0));
-    // Mann–Whitney U from ranks (average ranks for ties).
-    let mut rank_sum = 0.0;
-    let mut i = 0;
-    while i < all.len() {
-        let mut j = i;
-        while j + 1 < all.len() && all[j + 1].0 == all[i].0 {
-            j += 1;
-        }
-        let rank = (i + j) as f64 / 2.0 + 1.0;
-        rank_sum += all[i..=j].iter().filter(|a| a.1).count() as f64 * rank;
-        i = j + 1;
-    }
-    let nl = lost.len() as f64;
-    (rank_sum - nl * (nl + 1.0) / 2.0) / (nl * right.len() as f64)
 }
 
 /// The fingertips' image positions' Jacobian by finite differences: two rows (u, v) per tip
