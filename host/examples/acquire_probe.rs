@@ -462,7 +462,7 @@ fn claim_against_truth(
     acquire: &AcquireConfig,
 ) -> Result<String> {
     let mut bufs = buffers(&sequence.cameras, acquire);
-    let maps = edge_maps(&mut bufs, views, acquire)?;
+    let maps = kept::edge_maps(&mut bufs, views, &acquire.likelihood)?;
     let mut scorer = StateScorer::new();
     let scene = Scene::new(&sequence.model, &sequence.cameras, views, &maps);
     let mut score = |s: &[f32]| scorer.score_cameras(&scene, s, &acquire.likelihood);
@@ -530,19 +530,6 @@ fn depth_flipped(camera: &Camera, q: &[f32]) -> [f32; 4] {
     let across_palm = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0));
     let flipped = camera.r.transpose() * across_ray * camera.r * world * across_palm;
     digiteyes_core::quaternion::from_rotation(&flipped)
-}
-
-/// Edge maps of `views` in `buffers`.
-fn edge_maps<'b>(
-    buffers: &'b mut [Vec<u8>],
-    views: &[FrameView<'_>],
-    acquire: &AcquireConfig,
-) -> Result<Vec<EdgeMap<'b>>> {
-    buffers
-        .iter_mut()
-        .zip(views)
-        .map(|(b, v)| EdgeMap::build(b, v, &acquire.likelihood).map_err(|e| anyhow!("{e}")))
-        .collect()
 }
 
 fn buffers(cameras: &[Camera], acquire: &AcquireConfig) -> Vec<Vec<u8>> {
@@ -1035,7 +1022,7 @@ fn hand_free_run(sequence: &Sequence, args: &Args, csv: &mut Option<std::fs::Fil
         let views = hand_free_views(sequence, &frames)?;
         // The search to its end on this frame, then its leaves on the same frame.
         loop {
-            let maps = edge_maps(&mut bufs, &views, &acquire)?;
+            let maps = kept::edge_maps(&mut bufs, &views, &acquire.likelihood)?;
             finder
                 .step(&mut tracker, &views, &maps)
                 .map_err(|e| anyhow!("{e}"))?;

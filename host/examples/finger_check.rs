@@ -43,8 +43,7 @@ use digiteyes_core::nalgebra::Vector2;
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_core::silhouette::{covers, hand_bounds};
 use digiteyes_core::visibility::{candidates, cover_among, Cover};
-use digiteyes_host::bench::robustness::{judge_frame, TRULY_LOST_TIP_PX_AT_640};
-use digiteyes_host::eval::{evaluate, reprojection_error, stats};
+use digiteyes_host::eval::{reprojection_error, stats};
 use digiteyes_host::sequence::{read_states, Sequence};
 
 #[derive(Parser)]
@@ -266,24 +265,27 @@ fn open(dir: &Path) -> Result<Kept> {
     Ok((sequence, truth, kept))
 }
 
-/// One camera's edge maps of `frames`, in `buffers`.
-fn edge_maps<'a>(
-    buffers: &'a mut [Vec<u8>],
-    frames: &[FrameView<'_>],
+/// `f` of the rig of `seq`'s instant `k`: its frames and their edge maps.
+fn with_rig<R>(
+    seq: &Sequence,
+    k: usize,
+    fingers: &Fingers,
     config: &LikelihoodConfig,
-) -> Result<Vec<EdgeMap<'a>>> {
-    buffers
-        .iter_mut()
-        .zip(frames)
-        .map(|(b, f)| EdgeMap::build(b, f, config).map_err(|e| anyhow::anyhow!("{e}")))
-        .collect()
-}
-
-fn edge_buffers(frames: &[FrameView<'_>], config: &LikelihoodConfig) -> Vec<Vec<u8>> {
-    frames
-        .iter()
-        .map(|f| vec![0u8; EdgeMap::bytes_needed(f.width(), f.height(), config.stride_px)])
-        .collect()
+    f: impl FnOnce(&Rig<'_>) -> R,
+) -> Result<R> {
+    let images = kept::read_instant(seq, k)?;
+    let frames = kept::views(&images)?;
+    let mut buffers = kept::edge_buffers(&frames, config);
+    let edges = kept::edge_maps(&mut buffers, &frames, config)?;
+    let rig = Rig {
+        model: &seq.model,
+        fingers,
+        cameras: &seq.cameras,
+        frames: &frames,
+        edges: &edges,
+        config,
+    };
+    Ok(f(&rig))
 }
 
 /// `--drift`: per group, the AUC of the worst finger's change in chamfer (px) and in bright
@@ -296,31 +298,17 @@ fn drift(args: &Args) -> Result<()> {
     for dir in kept::seed_dirs(&args.dir)? {
         let seed = kept::seed_of(&dir);
         let (seq, truth, kept_states) = open(&dir)?;
-        let states_path = dir.join("states.csv");
-        let table = read_states(&states_path, seq.n_states())?;
-        let report = evaluate(&dir, &states_path)?;
-        let lost = table.extra("lost").unwrap_or_default();
-        let width = seq.cameras.first().map_or(640, |c| c.width);
-        let limit = TRULY_LOST_TIP_PX_AT_640 * f64::from(width) / 640.0;
+        let judged = kept::Judged::open(&dir, &seq)?;
         let model = &seq.model;
         let fingers = Fingers::of(model);
         let n = fingers.count();
         let mut history: Vec<Vec<(f32, f32)>> = vec![Vec::new(); n];
         let group = &mut groups[usize::from(seed.is_multiple_of(2))];
         for k in (1..truth.len().min(kept_states.len())).step_by(args.every.max(1)) {
-            let images = kept::read_instant(&seq, k)?;
-            let frames = kept::views(&images)?;
-            let mut buffers = edge_buffers(&frames, &config);
-            let edges = edge_maps(&mut buffers, &frames, &config)?;
-            let rig = Rig {
-                model,
-                fingers: &fingers,
-                cameras: &seq.cameras,
-                frames: &frames,
-                edges: &edges,
-                config: &config,
-            };
-            let Some((bright, chamfer, _)) = score_state(&rig, &kept_states[k]) else {
+            let scores = with_rig(&seq, k, &fingers, &config, |rig| {
+                score_state(rig, &kept_states[k])
+            })?;
+            let Some((bright, chamfer, _)) = scores else {
                 continue;
             };
             let (mut worst_change, mut worst_drop, mut worst_raw) = (0.0f64, 0.0f64, 0.0f64);
@@ -340,13 +328,11 @@ fn drift(args: &Args) -> Result<()> {
                 worst_drop = worst_drop.max(level(base, |x| x.1) - f64::from(bright[f]));
                 worst_raw = worst_raw.max(f64::from(chamfer[f]));
             }
-            let flagged = lost.get(k).is_some_and(|&v| v != 0.0);
+            let true_state: Vec<f64> = truth[k].iter().map(|&v| f64::from(v)).collect();
+            let (flagged, truly) = judged.frame(k, &true_state);
             if !referenced || flagged {
                 continue;
             }
-            let estimate: Vec<f64> = table.rows[k].clone();
-            let true_state: Vec<f64> = truth[k].iter().map(|&v| f64::from(v)).collect();
-            let (_, truly) = judge_frame(&estimate, &true_state, &report, k, limit);
             group.push((worst_change, worst_drop, worst_raw, truly));
         }
         eprintln!("{}", dir.display());
@@ -392,87 +378,78 @@ fn main() -> Result<()> {
             .filter_map(|i| kept::finger_of_frame(model, &fingers, i).map(|f| (f, i)))
             .collect();
         for k in (1..truth.len().min(kept.len())).step_by(args.every.max(1)) {
-            let images = kept::read_instant(&seq, k)?;
-            let frames = kept::views(&images)?;
-            let mut buffers = edge_buffers(&frames, &config);
-            let edges = edge_maps(&mut buffers, &frames, &config)?;
-            let rig = Rig {
-                model,
-                fingers: &fingers,
-                cameras: &seq.cameras,
-                frames: &frames,
-                edges: &edges,
-                config: &config,
-            };
-            let (pt, pe) = (
-                Poses::compute(model, &truth[k])?,
-                Poses::compute(model, &kept[k])?,
-            );
-            let Some((bright, chamfer, unexplained)) = score_state(&rig, &kept[k]) else {
-                continue;
-            };
-            let tip_err = |tip: usize| {
-                seq.cameras
-                    .iter()
-                    .map(|c| reprojection_error(c, &pt, &pe, tip))
-                    .fold(0.0f64, f64::max)
-            };
-            let wrong_count = tips.iter().filter(|&&(_, t)| tip_err(t) > 10.0).count();
-            let others_right =
-                tips.iter().filter(|&&(_, t)| tip_err(t) < 5.0).count() + 1 == tips.len();
-            if args.single && !(wrong_count == 0 || (wrong_count == 1 && others_right)) {
-                continue;
-            }
-            let pen = penetration(&rig, &kept[k]).unwrap_or_default();
-            let pen_truth = penetration(&rig, &truth[k]).unwrap_or_default();
-            let mut any_wrong = false;
-            for &(f, tip) in &tips {
-                let e = tip_err(tip);
-                if let (Some(p), Some(pt)) = (pen.get(f), pen_truth.get(f)) {
-                    if e < 3.0 {
-                        pen_right.push(f64::from(*p));
-                    } else if e > 10.0 {
-                        pen_wrong.push(f64::from(*p));
-                        pen_truth_wrong.push(f64::from(*pt));
-                    }
+            with_rig(&seq, k, &fingers, &config, |rig| -> Result<()> {
+                let (pt, pe) = (
+                    Poses::compute(model, &truth[k])?,
+                    Poses::compute(model, &kept[k])?,
+                );
+                let Some((bright, chamfer, unexplained)) = score_state(rig, &kept[k]) else {
+                    return Ok(());
+                };
+                let tip_err = |tip: usize| {
+                    seq.cameras
+                        .iter()
+                        .map(|c| reprojection_error(c, &pt, &pe, tip))
+                        .fold(0.0f64, f64::max)
+                };
+                let wrong_count = tips.iter().filter(|&&(_, t)| tip_err(t) > 10.0).count();
+                let others_right =
+                    tips.iter().filter(|&&(_, t)| tip_err(t) < 5.0).count() + 1 == tips.len();
+                if args.single && !(wrong_count == 0 || (wrong_count == 1 && others_right)) {
+                    return Ok(());
                 }
-                let err = seq
-                    .cameras
-                    .iter()
-                    .map(|c| reprojection_error(c, &pt, &pe, tip))
-                    .fold(0.0f64, f64::max);
-                let (b, c) = (f64::from(bright[f]), f64::from(chamfer[f]));
-                if err < 3.0 {
-                    bright_right.push(b);
-                    chamfer_right.push(c);
-                } else if err > 10.0 {
-                    any_wrong = true;
-                    bright_wrong.push(b);
-                    chamfer_wrong.push(c);
-                    // The same hand with this finger's joints at the truth.
-                    let mut q = kept[k].clone();
-                    for (s, v) in q.iter_mut().enumerate() {
-                        if fingers.contains(f, s) {
-                            *v = truth[k][s];
+                let pen = penetration(rig, &kept[k]).unwrap_or_default();
+                let pen_truth = penetration(rig, &truth[k]).unwrap_or_default();
+                let mut any_wrong = false;
+                for &(f, tip) in &tips {
+                    let e = tip_err(tip);
+                    if let (Some(p), Some(pt)) = (pen.get(f), pen_truth.get(f)) {
+                        if e < 3.0 {
+                            pen_right.push(f64::from(*p));
+                        } else if e > 10.0 {
+                            pen_wrong.push(f64::from(*p));
+                            pen_truth_wrong.push(f64::from(*pt));
                         }
                     }
-                    if let Some((b2, c2, u2)) = score_state(&rig, &q) {
-                        asked += 1;
-                        prefers_bright += usize::from(b2[f] > bright[f]);
-                        prefers_chamfer += usize::from(c2[f] < chamfer[f]);
-                        prefers_unexpl += usize::from(u2 < unexplained);
+                    let err = seq
+                        .cameras
+                        .iter()
+                        .map(|c| reprojection_error(c, &pt, &pe, tip))
+                        .fold(0.0f64, f64::max);
+                    let (b, c) = (f64::from(bright[f]), f64::from(chamfer[f]));
+                    if err < 3.0 {
+                        bright_right.push(b);
+                        chamfer_right.push(c);
+                    } else if err > 10.0 {
+                        any_wrong = true;
+                        bright_wrong.push(b);
+                        chamfer_wrong.push(c);
+                        // The same hand with this finger's joints at the truth.
+                        let mut q = kept[k].clone();
+                        for (s, v) in q.iter_mut().enumerate() {
+                            if fingers.contains(f, s) {
+                                *v = truth[k][s];
+                            }
+                        }
+                        if let Some((b2, c2, u2)) = score_state(rig, &q) {
+                            asked += 1;
+                            prefers_bright += usize::from(b2[f] > bright[f]);
+                            prefers_chamfer += usize::from(c2[f] < chamfer[f]);
+                            prefers_unexpl += usize::from(u2 < unexplained);
+                        }
                     }
                 }
-            }
-            if any_wrong {
-                unexpl_wrong.push(f64::from(unexplained));
-            } else if tips.iter().all(|&(_, tip)| {
-                seq.cameras
-                    .iter()
-                    .all(|c| reprojection_error(c, &pt, &pe, tip) < 3.0)
-            }) {
-                unexpl_right.push(f64::from(unexplained));
-            }
+                if any_wrong {
+                    unexpl_wrong.push(f64::from(unexplained));
+                } else if tips.iter().all(|&(_, tip)| {
+                    seq.cameras
+                        .iter()
+                        .all(|c| reprojection_error(c, &pt, &pe, tip) < 3.0)
+                }) {
+                    unexpl_right.push(f64::from(unexplained));
+                }
+                Ok(())
+            })??;
         }
         eprintln!("{}", dir.display());
     }

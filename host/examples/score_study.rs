@@ -323,16 +323,8 @@ fn study(dir: &Path, args: &Args) -> Result<Vec<FrameScores>> {
         }
         let images = kept::read_instant(&sequence, k)?;
         let frames = kept::views(&images)?;
-        let mut buffers: Vec<Vec<u8>> = frames
-            .iter()
-            .map(|f| vec![0u8; EdgeMap::bytes_needed(f.width(), f.height(), likelihood.stride_px)])
-            .collect();
-        let mut maps = Vec::new();
-        for (buffer, frame) in buffers.iter_mut().zip(&frames) {
-            maps.push(
-                EdgeMap::build(buffer, frame, &likelihood).map_err(|e| anyhow::anyhow!("{e}"))?,
-            );
-        }
+        let mut buffers = kept::edge_buffers(&frames, &likelihood);
+        let maps = kept::edge_maps(&mut buffers, &frames, &likelihood)?;
         let scene = Scene::new(model, &sequence.cameras, &frames, &maps);
         let truth_poses = Poses::compute(model, &truth[k])?;
         let mut states: Vec<Vec<f32>> = hypotheses

@@ -36,7 +36,7 @@ use clap::Parser;
 use digiteyes_core::hypotheses::fingers::Fingers;
 use digiteyes_core::hypotheses::HypothesesConfig;
 use digiteyes_core::kinematics::Poses;
-use digiteyes_core::likelihood::{shading, EdgeMap, Scene, StateScorer};
+use digiteyes_core::likelihood::{shading, Scene, StateScorer};
 use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::projection::ProjectedModel;
 use digiteyes_core::tracker::Tracker;
@@ -349,8 +349,8 @@ fn main() -> Result<()> {
                     }
                 }
                 t.core += usize::from(core[1] < core[0]);
-                let mut buffers = edge_buffers(&frames, &likelihood);
-                let maps = edge_maps(&mut buffers, &frames, &likelihood)?;
+                let mut buffers = kept::edge_buffers(&frames, &likelihood);
+                let maps = kept::edge_maps(&mut buffers, &frames, &likelihood)?;
                 let scene = Scene::new(model, &sequence.cameras, &frames, &maps);
                 let (kept_score, fixed_score) = (
                     scorer.score(&scene, &states[k], &likelihood),
@@ -434,30 +434,6 @@ fn main() -> Result<()> {
     Ok(())
 }
 
-/// One instant's edge-map buffers, one per camera.
-fn edge_buffers(
-    frames: &[digiteyes_core::frame::FrameView<'_>],
-    likelihood: &digiteyes_core::likelihood::LikelihoodConfig,
-) -> Vec<Vec<u8>> {
-    frames
-        .iter()
-        .map(|f| vec![0u8; EdgeMap::bytes_needed(f.width(), f.height(), likelihood.stride_px)])
-        .collect()
-}
-
-/// Each camera's edge map of `frames`, built in `buffers`.
-fn edge_maps<'a>(
-    buffers: &'a mut [Vec<u8>],
-    frames: &[digiteyes_core::frame::FrameView<'_>],
-    likelihood: &digiteyes_core::likelihood::LikelihoodConfig,
-) -> Result<Vec<EdgeMap<'a>>> {
-    buffers
-        .iter_mut()
-        .zip(frames)
-        .map(|(b, f)| EdgeMap::build(b, f, likelihood).map_err(|e| anyhow::anyhow!("{e}")))
-        .collect()
-}
-
 /// One seed, for a per-finger library's re-search.
 struct Library<'a> {
     model: &'a Model,
@@ -496,8 +472,8 @@ impl Library<'_> {
         let (finger, tip) = (at.finger, at.tip);
         let images = kept::read_instant(self.sequence, at.k)?;
         let frames = kept::views(&images)?;
-        let mut buffers = edge_buffers(&frames, &likelihood);
-        let maps = edge_maps(&mut buffers, &frames, &likelihood)?;
+        let mut buffers = kept::edge_buffers(&frames, &likelihood);
+        let maps = kept::edge_maps(&mut buffers, &frames, &likelihood)?;
         let scene = Scene::new(self.model, &self.sequence.cameras, &frames, &maps);
         let finger_err = |q: &[f32]| -> Result<f64> {
             let p = Poses::compute(self.model, q)?;

@@ -29,10 +29,8 @@ use digiteyes_core::camera::Camera;
 use digiteyes_core::kinematics::Poses;
 use digiteyes_core::model::{Model, Shape};
 use digiteyes_core::nalgebra::{SMatrix, Vector3};
-use digiteyes_host::bench::robustness::{judge_frame, TRULY_LOST_TIP_PX_AT_640};
-use digiteyes_host::eval::evaluate;
 use digiteyes_host::eval::stats::percentile;
-use digiteyes_host::sequence::{read_states, Sequence};
+use digiteyes_host::sequence::Sequence;
 use digiteyes_host::sequence_tracker;
 
 /// States (all of them; a state not free keeps a unit variance and no column).
@@ -86,12 +84,7 @@ fn main() -> Result<()> {
             let seed = kept::seed_of(&seed_dir);
             let sequence = Sequence::open(&seed_dir)?;
             let truth = sequence.read_truth()?;
-            let states_path = seed_dir.join("states.csv");
-            let table = read_states(&states_path, sequence.n_states())?;
-            let report = evaluate(&seed_dir, &states_path)?;
-            let lost = table.extra("lost").unwrap_or_default();
-            let width = sequence.cameras.first().map_or(640, |c| c.width);
-            let limit = TRULY_LOST_TIP_PX_AT_640 * f64::from(width) / 640.0;
+            let judged = kept::Judged::open(&seed_dir, &sequence)?;
             let (config, _) = kept::variant("default")?;
             let mut tracker = sequence_tracker(&sequence, config)?;
             let prior = tracker.config().motion.prior;
@@ -119,13 +112,12 @@ fn main() -> Result<()> {
                 })
             };
             let mut sigmas: Vec<Cov> = pairs.iter().map(|&(q, _)| fresh(q)).collect();
-            let rows = kept::f32s(&table.rows);
+            let rows = kept::f32s(&judged.table.rows);
             let model = tracker.model().clone();
             let cameras = tracker.cameras().to_vec();
             let g = &mut groups[usize::from(seed.is_multiple_of(2))];
-            for (k, (estimate, true_state)) in table.rows.iter().zip(&truth.rows).enumerate() {
-                let (_, truly) = judge_frame(estimate, true_state, &report, k, limit);
-                let flagged = lost.get(k).is_some_and(|&v| v != 0.0);
+            for (k, true_state) in truth.rows.iter().enumerate().take(rows.len()) {
+                let (flagged, truly) = judged.frame(k, true_state);
                 let state = &rows[k];
                 tracker.reset(state)?;
                 let images = kept::read_instant(&sequence, k)?;

@@ -9,8 +9,12 @@ use digiteyes_core::estimator::Robust;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::fingers::Fingers;
 use digiteyes_core::kinematics::Poses;
+use digiteyes_core::likelihood::{EdgeMap, LikelihoodConfig};
 use digiteyes_core::model::{Model, Shape};
-use digiteyes_host::sequence::Sequence;
+use digiteyes_host::bench::robustness::{judge_frame, TRULY_LOST_TIP_PX_AT_640};
+use digiteyes_host::eval::{evaluate, EvalReport};
+use digiteyes_host::sequence::states::StateTable;
+use digiteyes_host::sequence::{read_states, Sequence};
 use digiteyes_host::track::TrackOptions;
 use digiteyes_host::TrackerConfig;
 use image::GrayImage;
@@ -55,6 +59,67 @@ pub fn views(images: &[GrayImage]) -> Result<Vec<FrameView<'_>>> {
             FrameView::packed(img.as_raw(), img.width() as usize, img.height() as usize)
                 .map_err(|e| anyhow!("{e}"))
         })
+        .collect()
+}
+
+/// A kept seed's run as the benchmark judges it.
+pub struct Judged {
+    /// The states the benchmark wrote (`states.csv`).
+    pub table: StateTable,
+    /// `eval`'s report of them.
+    pub report: EvalReport,
+    /// The `lost` column (nonzero: flagged).
+    pub lost: Vec<f64>,
+    /// The truly-lost fingertip limit at the sequence's width (px).
+    pub limit_px: f64,
+}
+
+impl Judged {
+    /// The run in `dir` (a kept seed's folder) of `sequence`.
+    pub fn open(dir: &Path, sequence: &Sequence) -> Result<Judged> {
+        let states = dir.join("states.csv");
+        let table = read_states(&states, sequence.n_states())?;
+        let report = evaluate(dir, &states)?;
+        let lost = table.extra("lost").unwrap_or_default();
+        let width = sequence.cameras.first().map_or(640, |c| c.width);
+        Ok(Judged {
+            table,
+            report,
+            lost,
+            limit_px: TRULY_LOST_TIP_PX_AT_640 * f64::from(width) / 640.0,
+        })
+    }
+
+    /// Whether frame `k` was flagged lost, and whether it is truly lost against `truth`.
+    pub fn frame(&self, k: usize, truth: &[f64]) -> (bool, bool) {
+        let flagged = self.lost.get(k).is_some_and(|&v| v != 0.0);
+        let truly =
+            self.table.rows.get(k).is_none_or(|estimate| {
+                judge_frame(estimate, truth, &self.report, k, self.limit_px).1
+            });
+        (flagged, truly)
+    }
+}
+
+/// One instant's edge-map buffers, one per camera of `frames`.
+pub fn edge_buffers(frames: &[FrameView<'_>], likelihood: &LikelihoodConfig) -> Vec<Vec<u8>> {
+    frames
+        .iter()
+        .map(|f| vec![0u8; EdgeMap::bytes_needed(f.width(), f.height(), likelihood.stride_px)])
+        .collect()
+}
+
+/// Each camera's edge map of `frames`, built in `buffers` (from [`edge_buffers`], or sized
+/// alike).
+pub fn edge_maps<'a>(
+    buffers: &'a mut [Vec<u8>],
+    frames: &[FrameView<'_>],
+    likelihood: &LikelihoodConfig,
+) -> Result<Vec<EdgeMap<'a>>> {
+    buffers
+        .iter_mut()
+        .zip(frames)
+        .map(|(b, f)| EdgeMap::build(b, f, likelihood).map_err(|e| anyhow!("{e}")))
         .collect()
 }
 
