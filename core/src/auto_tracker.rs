@@ -49,13 +49,13 @@ use heapless::Vec;
 
 use crate::acquire::{
     AcceptConfig, AcquireConfig, Acquirer, Finder, FinderConfig, FinderStep, LeafScore,
-    WorkingVolume, DEPTH_VARIANTS, LOCAL_VARIANTS, MAX_KEEP,
+    WorkingVolume, DEPTH_VARIANTS, HELD_VARIANTS, LOCAL_VARIANTS, MAX_KEEP,
 };
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_HYPOTHESES, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
-use crate::hypotheses::{HypothesesConfig, Hypothesis, MultiReport, MultiTracker};
+use crate::hypotheses::{DepthAnchor, HypothesesConfig, Hypothesis, MultiReport, MultiTracker};
 use crate::likelihood::{BuiltEdges, EdgeMap, LikelihoodConfig, LikelihoodError, Reads, Scene};
 use crate::model::Model;
 use crate::motion::PriorWeights;
@@ -254,7 +254,7 @@ fn padded(state: &[f32]) -> [f32; MAX_STATES] {
 
 /// The palm's distance from the first camera (mm), if there is a camera and `state` has a
 /// palm position.
-fn palm_depth_mm(cameras: &[Camera], state: &[f32]) -> Option<f32> {
+pub(crate) fn palm_depth_mm(cameras: &[Camera], state: &[f32]) -> Option<f32> {
     let camera = cameras.first()?;
     let p = state.get(TRANSLATION)?;
     Some((Vector3::new(p[0], p[1], p[2]) - camera.centre()).norm())
@@ -897,8 +897,39 @@ impl AutoTracker {
             let depth_mm = palm_depth_mm(tracker.cameras(), tracker.state())?;
             finder.confirm_rival_mm(tracker.cameras().len(), depth_mm)
         });
-        let mut carried: Vec<[f32; MAX_STATES], { MAX_KEEP + DEPTH_VARIANTS as usize }> =
-            Vec::new();
+        let mut carried: Vec<
+            [f32; MAX_STATES],
+            { MAX_KEEP + (DEPTH_VARIANTS + HELD_VARIANTS) as usize },
+        > = Vec::new();
+        // The last claimed depth, when the hand was claimed before and the weight asks.
+        let held_mm =
+            (depth_share.is_some() && self.ever_tracked && finder.confirm_held_weight > 0.0)
+                .then(|| palm_depth_mm(tracker.cameras(), &self.held))
+                .flatten()
+                .filter(|mm| mm.is_finite() && *mm > 0.0);
+        let mut anchor = None;
+        if let (Some(held_mm), Some(depth_mm)) =
+            (held_mm, palm_depth_mm(tracker.cameras(), tracker.state()))
+        {
+            anchor = Some(DepthAnchor {
+                depth_mm: held_mm,
+                weight: finder.confirm_held_weight,
+                band: finder.confirm_held_band,
+            });
+            let apart = self.rival_depth_mm.unwrap_or(0.0);
+            if (held_mm - depth_mm).abs() >= apart && depth_mm > 0.0 {
+                let q = padded(tracker.state());
+                let share = held_mm / depth_mm - 1.0;
+                let moved = self.finder.acquirer().variant(
+                    tracker.cameras(),
+                    &q,
+                    DEPTH_FARTHER,
+                    0.0,
+                    share,
+                );
+                let _ = carried.push(moved);
+            }
+        }
         if let Some(share) = depth_share {
             let q = padded(tracker.state());
             for k in [DEPTH_FARTHER, DEPTH_NEARER] {
@@ -939,6 +970,7 @@ impl AutoTracker {
             // The search's leaves are judged by the search's likelihood, whatever the
             // tracker's hypotheses weigh.
             likelihood: self.finder.acquirer().config().likelihood,
+            depth_anchor: anchor,
             ..self.hypotheses
         });
         self.multi.seed(others)?;

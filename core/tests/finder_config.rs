@@ -2,7 +2,7 @@
 //! how many hypotheses the confirm phase may then carry, and how far its best may lie in depth
 //! and be claimed.
 
-use digiteyes_core::acquire::{FinderConfig, DEPTH_VARIANTS};
+use digiteyes_core::acquire::{FinderConfig, DEPTH_VARIANTS, HELD_VARIANTS};
 
 fn with_shares(shared: f32, one_camera: f32) -> FinderConfig {
     FinderConfig {
@@ -17,8 +17,27 @@ fn the_default_carries_depth_variants_with_one_camera_only() {
     assert_eq!(f.confirm_depth(1), Some(f.confirm_depth_share[1]));
     assert_eq!(f.confirm_depth(2), None);
     assert_eq!(f.confirm_depth(3), None);
-    assert_eq!(f.confirm_capacity(1), f.confirm_hypotheses + DEPTH_VARIANTS);
+    assert_eq!(
+        f.confirm_capacity(1),
+        f.confirm_hypotheses + DEPTH_VARIANTS + HELD_VARIANTS
+    );
     assert_eq!(f.confirm_capacity(2), f.confirm_hypotheses);
+}
+
+#[test]
+fn the_last_claimed_depth_takes_a_place_only_while_weighed() {
+    assert!(FinderConfig::default().confirm_held_weight > 0.0);
+    for weight in [0.0, -1.0, f32::NAN] {
+        let f = FinderConfig {
+            confirm_held_weight: weight,
+            ..FinderConfig::default()
+        };
+        assert_eq!(
+            f.confirm_capacity(1),
+            f.confirm_hypotheses + DEPTH_VARIANTS,
+            "weight {weight}"
+        );
+    }
 }
 
 #[test]

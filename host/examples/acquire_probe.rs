@@ -136,6 +136,12 @@ struct Args {
     /// How far the local re-acquisition moves the palm in depth with one camera (a share).
     #[arg(long)]
     local_depth_mono: Option<f32>,
+    /// The confirm phase's weight on the depth of the last claimed state (0: off).
+    #[arg(long)]
+    held_weight: Option<f32>,
+    /// The band past which that weight's penalty grows no more (a share of the depth).
+    #[arg(long)]
+    held_band: Option<f32>,
     /// How far the local re-acquisition's variants turn the palm (rad).
     #[arg(long)]
     local_turn: Option<f32>,
@@ -338,6 +344,8 @@ fn configs(args: &Args) -> (AcquireConfig, FinderConfig) {
             f.local_depth_share[0],
             args.local_depth_mono.unwrap_or(f.local_depth_share[1]),
         ],
+        confirm_held_weight: args.held_weight.unwrap_or(f.confirm_held_weight),
+        confirm_held_band: args.held_band.unwrap_or(f.confirm_held_band),
         confirm_switch_margin: args.confirm_switch.unwrap_or(f.confirm_switch_margin),
         confirm_score_memory: args.confirm_memory.unwrap_or(f.confirm_score_memory),
         settle_frames: args.settle_frames.unwrap_or(f.settle_frames),
@@ -779,6 +787,8 @@ struct BlackoutRun {
     dark_claimed: usize,
     /// Searching frames.
     searching: usize,
+    /// Claimed frames after the return with the palm over 30 mm and over 100 mm from the truth.
+    palm_off: (usize, usize),
 }
 
 /// Tracks `sequence` from its initial state through the blackout `dark`.
@@ -800,6 +810,7 @@ fn blackout_run(
         reacquired_after: None,
         dark_claimed: 0,
         searching: 0,
+        palm_off: (0, 0),
     };
     let mut line = String::new();
     let mut errors = String::new();
@@ -857,6 +868,15 @@ fn blackout_run(
         if report.status == Status::Searching {
             out.searching += 1;
         }
+        if claimed && k >= dark.end {
+            let st = auto.state();
+            let palm_mm = (4..7)
+                .map(|i| (st[i] - truth_k[i]).powi(2))
+                .sum::<f32>()
+                .sqrt();
+            out.palm_off.0 += usize::from(palm_mm > 30.0);
+            out.palm_off.1 += usize::from(palm_mm > 100.0);
+        }
         good.push(claimed && e <= limit);
         over.push(!(claimed && e <= limit));
     }
@@ -878,8 +898,8 @@ fn blackout_run(
 fn blackout_sweep(args: &Args, dark: &std::ops::Range<usize>) -> Result<()> {
     let dir = tempfile::tempdir()?;
     let (w, h) = (args.width, args.width * 3 / 4);
-    println!("| seed | rig | tracked to the blackout | re-acquired after (frames) | dark frames claimed | searching frames |");
-    println!("|---|---|---|---|---|---|");
+    println!("| seed | rig | tracked to the blackout | re-acquired after (frames) | dark frames claimed | searching frames | claimed, palm > 30 / 100 mm |");
+    println!("|---|---|---|---|---|---|---|");
     for rig in &args.rigs {
         let mut runs = Vec::new();
         for seed in args.seeds.clone() {
@@ -895,11 +915,13 @@ fn blackout_sweep(args: &Args, dark: &std::ops::Range<usize>) -> Result<()> {
             let sequence = Sequence::open(&seq)?;
             let r = blackout_run(&sequence, args, dark, &format!("{rig}-{seed}"))?;
             println!(
-                "| {seed} | {rig} | {} | {} | {} | {} |",
+                "| {seed} | {rig} | {} | {} | {} | {} | {} / {} |",
                 r.tracked_to_dark,
                 r.reacquired_after.map_or("never".into(), |k| k.to_string()),
                 r.dark_claimed,
-                r.searching
+                r.searching,
+                r.palm_off.0,
+                r.palm_off.1
             );
             std::fs::remove_dir_all(&seq)?;
             runs.push(r);
@@ -909,9 +931,13 @@ fn blackout_sweep(args: &Args, dark: &std::ops::Range<usize>) -> Result<()> {
         after.sort();
         let all: usize = runs.iter().filter(|r| r.reacquired_after.is_some()).count();
         let claimed: usize = runs.iter().map(|r| r.dark_claimed).sum();
+        let off30: usize = runs.iter().map(|r| r.palm_off.0).sum();
+        let off100: usize = runs.iter().map(|r| r.palm_off.1).sum();
         println!(
             "{rig}: tracked to the blackout {}/{}; of those re-acquired {}/{} (frames after the \
-             return: {after:?}); re-acquired over all seeds {all}/{}; dark frames claimed {claimed}",
+             return: {after:?}); re-acquired over all seeds {all}/{}; dark frames claimed \
+             {claimed}; claimed after the return with the palm over 30 mm {off30}, over 100 mm \
+             {off100}",
             tracked.len(),
             runs.len(),
             after.len(),

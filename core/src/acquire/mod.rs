@@ -40,7 +40,7 @@ mod rotation;
 mod volume;
 
 pub use accept::{AcceptConfig, LeafScore, Verdict};
-pub use finder::{Finder, FinderConfig, FinderStep, DEPTH_VARIANTS, LOCAL_TURN_RAD};
+pub use finder::{Finder, FinderConfig, FinderStep, DEPTH_VARIANTS, HELD_VARIANTS, LOCAL_TURN_RAD};
 pub use library::{FingerPose, POSE_COUNT};
 pub use place::{triangulate, Depth};
 pub use volume::WorkingVolume;

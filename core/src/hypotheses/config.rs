@@ -1,5 +1,6 @@
 //! How many hypotheses, how they are sampled, merged and chosen.
 
+use super::DepthAnchor;
 use crate::config::{MAX_HYPOTHESES, MAX_JUMPS, MAX_SPAWN};
 use crate::likelihood::LikelihoodConfig;
 use crate::state::StateKind;
@@ -96,6 +97,10 @@ pub struct HypothesesConfig {
     /// every set and the share of frames held rises (`docs/hypotheses.md`, "Temporal
     /// consistency"). The search's confirm phase ranks its leaves without it.
     pub motion_weight: f32,
+    /// Temporal consistency in depth: [`DepthAnchor::penalty`] taken off each candidate's
+    /// score; `None` by default (the search's confirm phase sets it after a loss:
+    /// [`FinderConfig::confirm_held_weight`](crate::acquire::FinderConfig::confirm_held_weight)).
+    pub depth_anchor: Option<DepthAnchor>,
     /// How much of a carried hypothesis' past scores its rank keeps, 0..=1: each scored
     /// frame its ranked score becomes `memory × past + (1 − memory) × score` (0: ranked by
     /// this frame's score alone). A frame's score is noisy by about 0.005 between near
@@ -171,6 +176,7 @@ impl Default for HypothesesConfig {
             switch_margin: 0.01,
             lost_penalty: 0.2,
             motion_weight: 0.05,
+            depth_anchor: None,
             score_memory: 0.0,
             score_every_frames: 1,
             likelihood: LikelihoodConfig {

@@ -19,6 +19,7 @@
 //! for bit. The edge maps the likelihood needs live in the caller's buffers, one per camera.
 
 pub mod config;
+pub mod depth_anchor;
 pub mod fingers;
 pub mod jump;
 pub mod merge;
@@ -29,8 +30,9 @@ pub mod weak;
 use heapless::Vec;
 
 pub use config::{HypothesesConfig, Spread};
+pub use depth_anchor::DepthAnchor;
 
-use crate::auto_tracker::AutoError;
+use crate::auto_tracker::{palm_depth_mm, AutoError};
 use crate::camera::Camera;
 use crate::config::{MAX_CAMERAS, MAX_CANDIDATES, MAX_HYPOTHESES};
 use crate::estimator::FreeMask;
@@ -421,6 +423,10 @@ impl MultiTracker {
                     score -= self.config.motion_weight
                         * departure(&c.memory.state, &p.memory, free, &self.config.spread);
                 }
+            }
+            if let Some(anchor) = self.config.depth_anchor {
+                let depth_mm = palm_depth_mm(self.tracker.cameras(), &c.memory.state);
+                score -= anchor.penalty(depth_mm.unwrap_or(f32::NAN));
             }
             c.score = score;
             c.ranked_score = Some(rank::ranked_score(

@@ -224,6 +224,8 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "cdepth1" => o.finder.confirm_depth_share[1] = f,
             "rival" => o.finder.confirm_rival_share = f,
             "rivalm" => o.finder.confirm_rival_margin = f,
+            "held" => o.finder.confirm_held_weight = f,
+            "heldband" => o.finder.confirm_held_band = f,
             "cframes" => o.finder.confirm_frames = f as u8,
             "polish1" => o.finder.polish_margin[1] = f,
             "polish2" => o.finder.polish_margin[0] = f,
