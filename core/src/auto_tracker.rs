@@ -880,7 +880,9 @@ impl AutoTracker {
     /// Carries `others` beside the tracker's present state as hypotheses for
     /// [`FinderConfig::confirm_frames`] frames; with `depth_variants`, the present state moved
     /// nearer and farther along the first camera's ray first
-    /// ([`FinderConfig::confirm_depth_share`]).
+    /// ([`FinderConfig::confirm_depth_share`]), and, when the hand was claimed before, moved
+    /// to the depth it was last claimed at, which all of them are then ranked toward
+    /// ([`FinderConfig::confirm_held_weight`]).
     fn carry(
         &mut self,
         others: &[[f32; MAX_STATES]],
@@ -902,11 +904,12 @@ impl AutoTracker {
             { MAX_KEEP + (DEPTH_VARIANTS + HELD_VARIANTS) as usize },
         > = Vec::new();
         // The last claimed depth, when the hand was claimed before and the weight asks.
-        let held_mm =
-            (depth_share.is_some() && self.ever_tracked && finder.confirm_held_weight > 0.0)
-                .then(|| palm_depth_mm(tracker.cameras(), &self.held))
-                .flatten()
-                .filter(|mm| mm.is_finite() && *mm > 0.0);
+        let weighed = depth_share.is_some() && finder.confirm_held_weight > 0.0;
+        let held_mm = if weighed && self.ever_tracked {
+            palm_depth_mm(tracker.cameras(), &self.held).filter(|mm| mm.is_finite() && *mm > 0.0)
+        } else {
+            None
+        };
         let mut anchor = None;
         if let (Some(held_mm), Some(depth_mm)) =
             (held_mm, palm_depth_mm(tracker.cameras(), tracker.state()))
