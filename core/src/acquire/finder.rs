@@ -175,8 +175,10 @@ pub struct FinderConfig {
     pub confirm_held_weight: f32,
     /// The relative distance in depth past which [`FinderConfig::confirm_held_weight`]'s
     /// penalty grows no more (default 0.12: one camera reads a hand 8–11 % nearer or
-    /// farther, its fingers bent to match, as well as the right one; beyond that the image
-    /// tells, and a hand that came back at another depth is taken there).
+    /// farther, its fingers bent to match, as well as the right one). Beyond it the penalty is
+    /// flat, so among hypotheses there the image decides, as for a hand that came back at
+    /// another depth (by design: the sweep's motions stay within the band). Not positive, or
+    /// NaN: no penalty.
     pub confirm_held_band: f32,
     /// A leaf of the global search refused by the acceptance but scoring at least this, with
     /// two or more cameras (`[0]`) and with one (`[1]`), is pursued: refined again on each of
