@@ -51,7 +51,7 @@ use crate::acquire::{
     AcceptConfig, AcquireConfig, Acquirer, Finder, FinderConfig, FinderStep, LeafScore,
     WorkingVolume, DEPTH_VARIANTS, HELD_VARIANTS, LOCAL_VARIANTS, MAX_KEEP,
 };
-use crate::camera::Camera;
+use crate::camera::{palm_depth_mm, Camera};
 use crate::config::{MAX_CAMERAS, MAX_HYPOTHESES, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
@@ -59,8 +59,6 @@ use crate::hypotheses::{DepthAnchor, HypothesesConfig, Hypothesis, MultiReport, 
 use crate::likelihood::{BuiltEdges, EdgeMap, LikelihoodConfig, LikelihoodError, Reads, Scene};
 use crate::model::Model;
 use crate::motion::PriorWeights;
-use crate::nalgebra::Vector3;
-use crate::state::TRANSLATION;
 pub use crate::status::Status;
 use crate::tracker::{FrameReport, Tracker, TrackerConfig, TrackerError};
 use crate::watch::{Watch, WatchConfig};
@@ -250,14 +248,6 @@ fn padded(state: &[f32]) -> [f32; MAX_STATES] {
         *d = *s;
     }
     q
-}
-
-/// The palm's distance from the first camera (mm), if there is a camera and `state` has a
-/// palm position.
-pub(crate) fn palm_depth_mm(cameras: &[Camera], state: &[f32]) -> Option<f32> {
-    let camera = cameras.first()?;
-    let p = state.get(TRANSLATION)?;
-    Some((Vector3::new(p[0], p[1], p[2]) - camera.centre()).norm())
 }
 
 /// One edge map per camera, with its bright region, for the search: `frames[i]`'s, built

@@ -9,6 +9,7 @@ use core::fmt;
 use nalgebra::{Matrix2x3, Matrix3, Vector2, Vector3};
 
 use crate::float::Length;
+use crate::state::TRANSLATION;
 
 /// Points nearer than this to the camera plane (mm) do not project.
 pub const MIN_DEPTH: f32 = 1.0;
@@ -181,4 +182,12 @@ impl Camera {
             && uv.x <= self.width as f32 - 1.0 - margin
             && uv.y <= self.height as f32 - 1.0 - margin
     }
+}
+
+/// The palm's distance (mm) from the first of `cameras`, if there is a camera and `state`
+/// has a palm position: the depth one camera reads only through the hand's size.
+pub fn palm_depth_mm(cameras: &[Camera], state: &[f32]) -> Option<f32> {
+    let camera = cameras.first()?;
+    let p = state.get(TRANSLATION)?;
+    Some((Vector3::new(p[0], p[1], p[2]) - camera.centre()).norm())
 }

@@ -5,7 +5,7 @@
 mod common;
 
 use common::Rng;
-use digiteyes_core::camera::{Camera, CameraError, MIN_DEPTH};
+use digiteyes_core::camera::{palm_depth_mm, Camera, CameraError, MIN_DEPTH};
 use digiteyes_core::nalgebra::{Matrix3, Vector2, Vector3};
 
 /// The sequence-format example: 640×480, f = 1000, principal point at the image centre,
@@ -371,4 +371,30 @@ fn a_camera_looking_along_a_direction_centres_it_with_up_upward() {
     );
     assert!(Camera::looking_along(eye, Vector3::z(), Vector3::z(), (640, 480), 800.0).is_none());
     assert!(Camera::looking_along(eye, forward, Vector3::z(), (640, 480), 0.0).is_none());
+}
+
+#[test]
+fn the_palms_depth_is_its_distance_from_the_first_camera() {
+    let camera = Camera::looking_along(
+        Vector3::new(300.0, 0.0, 400.0),
+        Vector3::new(-3.0, 0.0, -4.0),
+        Vector3::new(0.0, 1.0, 0.0),
+        (640, 480),
+        1000.0,
+    )
+    .expect("a valid camera");
+    let mut state = [0.0f32; 7];
+    state[0] = 1.0;
+    // A palm at the world origin, 500 mm from the camera (a 3-4-5 triangle).
+    let depth = palm_depth_mm(&[camera, front_camera()], &state).expect("a depth");
+    assert!((depth - 500.0).abs() < 1e-3, "{depth}");
+    state[6] = 400.0;
+    let depth = palm_depth_mm(&[camera], &state).expect("a depth");
+    assert!((depth - 300.0).abs() < 1e-3, "{depth}");
+    assert_eq!(palm_depth_mm(&[], &state), None, "no camera");
+    assert_eq!(
+        palm_depth_mm(&[camera], &state[..5]),
+        None,
+        "no palm position"
+    );
 }

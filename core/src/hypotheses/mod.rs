@@ -32,8 +32,8 @@ use heapless::Vec;
 pub use config::{HypothesesConfig, Spread};
 pub use depth_anchor::DepthAnchor;
 
-use crate::auto_tracker::{palm_depth_mm, AutoError};
-use crate::camera::Camera;
+use crate::auto_tracker::AutoError;
+use crate::camera::{palm_depth_mm, Camera};
 use crate::config::{MAX_CAMERAS, MAX_CANDIDATES, MAX_HYPOTHESES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
