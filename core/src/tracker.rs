@@ -685,6 +685,7 @@ impl Tracker {
         report.features_masked = 0;
         report.links_skipped = 0;
         let config = &self.config;
+        let estimator = config.estimator.for_cameras(self.cameras.len());
         let fill_on = config.fill.is_on();
         for (camera_index, ((camera, view), fill)) in self
             .cameras
@@ -738,7 +739,7 @@ impl Tracker {
                         link,
                         &work.features,
                         &work.jacobian,
-                        &config.estimator,
+                        &estimator,
                         self.free,
                     );
                 }

@@ -202,7 +202,10 @@ fn the_tracker_and_the_oracle_build_the_same_normal_equations_for_every_wire_res
     let mut rng = Rng::new(11);
     let mut worst = [0.0f32; 4];
     let mut cases = 0;
-    for config in wire_configs() {
+    let mut width = TrackerConfig::default().estimator;
+    width.residual = ResidualKind::AxisPoints;
+    width.width_weight = 0.5;
+    for config in wire_configs().into_iter().chain([width]) {
         let kind = config.residual;
         for rig in [&cams[..1], &cams[..]] {
             for free in [FreeMask::all(n), mouse_free()] {
@@ -210,7 +213,12 @@ fn the_tracker_and_the_oracle_build_the_same_normal_equations_for_every_wire_res
                     let q = pose(&mut rng, &bent_pose());
                     let truth = pose(&mut rng, &q);
                     let (tracker, oracle) = both_ways(&model, rig, &q, &truth, &config, free);
-                    let what = format!("{kind:?}, {} camera(s), free {:#x}", rig.len(), free.0);
+                    let what = format!(
+                        "{kind:?}, width rows {}, {} camera(s), free {:#x}",
+                        config.width_weight,
+                        rig.len(),
+                        free.0
+                    );
                     assert!(tracker.rows() > 20, "{what}: {} rows", tracker.rows());
                     assert_eq!(tracker.rows(), oracle.rows(), "{what}: rows");
                     let rms = (tracker.rms() - oracle.rms()).abs() / oracle.rms();
@@ -264,7 +272,7 @@ fn the_tracker_and_the_oracle_build_the_same_normal_equations_for_every_wire_res
             }
         }
     }
-    assert_eq!(cases, 3 * 2 * 2 * 3);
+    assert_eq!(cases, 4 * 2 * 2 * 3);
     println!(
         "worst relative differences: RMS {:e}, JᵀWJ {:e}, step {:e} (backward {:e})",
         worst[0], worst[1], worst[2], worst[3]

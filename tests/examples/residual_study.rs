@@ -6,6 +6,10 @@
 use digiteyes_core::estimator::{Conditioning, ResidualKind, Robust};
 use digiteyes_host::{evaluate, render_scenario, track_sequence, RenderOptions, TrackerConfig};
 
+/// The axis points' width rows (`EstimatorConfig::width_weight`) compared besides, with one
+/// camera or two; the forms above run without them (one camera's default is 0.5).
+const WIDTH_WEIGHTS: [f32; 2] = [0.5, 1.0];
+
 fn main() -> anyhow::Result<()> {
     let frames: usize = std::env::args().nth(1).map_or(Ok(40), |s| s.parse())?;
     let dir = tempfile::tempdir()?;
@@ -25,7 +29,7 @@ fn main() -> anyhow::Result<()> {
             TrackerConfig::default().estimator.conditioning,
         ),
         (
-            "axis points + Huber 2 px (default)",
+            "axis points + Huber 2 px (default, no width rows)",
             ResidualKind::AxisPoints,
             Robust::Huber(2.0),
             TrackerConfig::default().estimator.conditioning,
@@ -83,11 +87,27 @@ fn main() -> anyhow::Result<()> {
             ..RenderOptions::default()
         };
         render_scenario(scenario, &seq, &options)?;
-        for (name, residual, robust, conditioning) in variants {
+        let widths = WIDTH_WEIGHTS.map(|w| {
+            let name = format!("axis points + Huber 2 px, width rows at {w}");
+            let default = TrackerConfig::default().estimator;
+            (
+                name,
+                default.residual,
+                default.robust,
+                default.conditioning,
+                w,
+            )
+        });
+        let plain = variants.map(|(name, residual, robust, conditioning)| {
+            (name.to_string(), residual, robust, conditioning, 0.0)
+        });
+        for (name, residual, robust, conditioning, width) in plain.into_iter().chain(widths) {
             let mut config = TrackerConfig::default();
             config.estimator.residual = residual;
             config.estimator.robust = robust;
             config.estimator.conditioning = conditioning;
+            config.estimator.width_weight = width;
+            config.estimator.one_camera_width_weight = width;
             let out = dir.path().join("states.csv");
             track_sequence(&seq, &out, config, false)?;
             let r = evaluate(&seq, &out)?;

@@ -89,6 +89,17 @@ pub struct EstimatorConfig {
     /// Weight of a palm outline edge row relative to a link's edge row
     /// ([`add_palm_edge_rows`](super::add_palm_edge_rows)).
     pub palm_edge_weight: f32,
+    /// With [`ResidualKind::AxisPoints`], the weight of a second row per slice where both of
+    /// its edges were found, relative to a lone edge's row: the mean of the two edges'
+    /// residuals, which reads the link's width in the image, so its depth. 0: no such row.
+    /// The rows use this weight; a tracker with one camera puts
+    /// [`one_camera_width_weight`](Self::one_camera_width_weight) in its place.
+    pub width_weight: f32,
+    /// [`width_weight`](Self::width_weight) for a tracker with one camera, where a link's
+    /// width is the one reading of its depth (two cameras triangulate it, and a width is
+    /// biased by shading that pulls both edges inward). Default 0.5, measured on the
+    /// robustness sweep (`docs/robustness.md`, "Stop 76: a link's width, with one camera").
+    pub one_camera_width_weight: f32,
     /// Solve each step with the joints it would carry out of their ranges held at their
     /// bounds and the other states solved again for it
     /// ([`NormalEquations::bounded_step`](super::NormalEquations::bounded_step)), instead of
@@ -100,6 +111,18 @@ pub struct EstimatorConfig {
     /// the single track nor the hypotheses (`tests/tests/hypotheses.rs`: K = 4 right on 2 of
     /// 10 noise seeds against 5 with the plain step).
     pub bounded_step: bool,
+}
+
+impl EstimatorConfig {
+    /// The rows' parameters for a tracker with `cameras` cameras: with one camera its
+    /// [`one_camera_width_weight`](Self::one_camera_width_weight) is the width rows' weight.
+    pub fn for_cameras(&self, cameras: usize) -> EstimatorConfig {
+        let mut config = *self;
+        if cameras == 1 {
+            config.width_weight = self.one_camera_width_weight;
+        }
+        config
+    }
 }
 
 impl Default for EstimatorConfig {
@@ -114,6 +137,8 @@ impl Default for EstimatorConfig {
             },
             tip_weight: 1.0,
             palm_edge_weight: 1.0,
+            width_weight: 0.0,
+            one_camera_width_weight: 0.5,
             bounded_step: false,
         }
     }

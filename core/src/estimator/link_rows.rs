@@ -258,6 +258,18 @@ pub(crate) fn add_weighted_link_rows(
                     Some(o) => {
                         let (mut plus, r_plus) = basis.row(link, e);
                         let (minus, r_minus) = basis.row(link, o);
+                        if config.width_weight > 0.0 {
+                            let mut width = [0.0; PARAMS];
+                            for ((m, a), b) in width.iter_mut().zip(&plus).zip(&minus) {
+                                *m = 0.5 * (a + b);
+                            }
+                            let r_width = 0.5 * (r_plus + r_minus);
+                            block.add(
+                                &width,
+                                r_width,
+                                weight * config.width_weight * config.robust.weight(r_width),
+                            );
+                        }
                         let half = 0.5 * f32::from(e.side);
                         for (a, b) in plus.iter_mut().zip(&minus) {
                             *a = (*a - b) * half;

@@ -94,7 +94,8 @@ pub fn tip_row(link: &ProjectedLink, jac: &LinkJacobian, tip: &Vector2<f32>, row
 /// Adds the rows of one link's features to `ne` one at a time, from the reference rows above:
 /// what [`add_link_rows`](super::add_link_rows) does, written the plain way. Edge rows for
 /// [`ResidualKind::EdgePoints`]; for [`ResidualKind::AxisPoints`] the half-difference of the
-/// two edge rows of a slice where both edges were found (a lone edge gives its edge row); for
+/// two edge rows of a slice where both edges were found (a lone edge gives its edge row), and
+/// with a `width_weight` their half-sum as well, at that weight; for
 /// [`ResidualKind::AxisLines`] the two [`line_row`]s against [`fit_axis_line`]'s line
 /// (unweighted); then the [`tip_row`] weighted by `tip_weight`. Edge and tip rows are
 /// robustly weighted.
@@ -146,6 +147,15 @@ pub(crate) fn add_weighted_reference_rows(
                         let half = 0.5 * f32::from(e.side);
                         let r_plus = edge_row(link, jac, e, &mut row);
                         let r_minus = edge_row(link, jac, o, &mut other);
+                        if config.width_weight > 0.0 {
+                            let mut width = row.clone();
+                            for ((_, a), (_, b)) in width.iter_mut().zip(&other) {
+                                *a = 0.5 * (*a + b);
+                            }
+                            let r_width = 0.5 * (r_plus + r_minus);
+                            let w = weight * config.width_weight * config.robust.weight(r_width);
+                            ne.add_row(&width, r_width, w, free);
+                        }
                         for ((_, a), (_, b)) in row.iter_mut().zip(&other) {
                             *a = (*a - b) * half;
                         }

@@ -197,7 +197,8 @@ impl<'a> Stages<'a> {
     /// [`Stages::keep_features`]): `LinkJacobian::compute` + `add_link_rows`. Returns the rows.
     pub fn jacobian_normal(&mut self) -> u16 {
         let model = self.tracker.model();
-        let config = &self.tracker.config().estimator;
+        let cameras = self.tracker.cameras().len();
+        let config = &self.tracker.config().estimator.for_cameras(cameras);
         let free = self.tracker.free();
         self.normal.clear();
         for ((view, camera), features) in self

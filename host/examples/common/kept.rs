@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
 use digiteyes_core::camera::Camera;
-use digiteyes_core::estimator::Robust;
+use digiteyes_core::estimator::{ResidualKind, Robust};
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::fingers::Fingers;
 use digiteyes_core::kinematics::Poses;
@@ -153,6 +153,15 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "knuckle" => c.features.knuckle_tips = f != 0.0,
             "fvf" => c.motion.full_velocity_found = f,
             "palmw" => c.estimator.palm_edge_weight = f,
+            "widthw" => c.estimator.width_weight = f,
+            "widthw1" => c.estimator.one_camera_width_weight = f,
+            "residual" => {
+                c.estimator.residual = match f as u8 {
+                    0 => ResidualKind::EdgePoints,
+                    1 => ResidualKind::AxisLines,
+                    _ => ResidualKind::AxisPoints,
+                }
+            }
             "bounds" => c.estimator.bounded_step = f != 0.0,
             "sj" => c.estimator.conditioning.joint = f,
             "st" => c.estimator.conditioning.translation = f,
