@@ -11,7 +11,7 @@ use core::fmt;
 use heapless::Vec;
 
 use crate::camera::{Camera, CameraError};
-use crate::config::{MAX_CAMERAS, MAX_STATES};
+use crate::config::{MAX_CAMERAS, MAX_LINKS, MAX_STATES};
 use crate::estimator::{
     add_link_rows, add_palm_edge_rows, add_region_rows, apply_step, EstimatorConfig, FreeMask,
     LinkJacobian, NormalEquations, Robust,
@@ -198,6 +198,9 @@ struct Workspace {
     fill: [FillPoints; MAX_CAMERAS],
     /// The fixed surfaces around the finger [`Tracker::refine_shading`] searches.
     shading: ShadingCache,
+    /// How many cameras found features on each link (by frame) in this frame's last
+    /// iteration; 0 before its first.
+    seen_by: [u8; MAX_LINKS],
 }
 
 /// What a [`Tracker`] knows of one hand between frames: the state, the motion the next
@@ -271,6 +274,7 @@ impl Tracker {
                 normal: NormalEquations::new(),
                 fill: Default::default(),
                 shading: ShadingCache::default(),
+                seen_by: [0; MAX_LINKS],
             },
         };
         tracker.reset(initial)?;
@@ -522,6 +526,7 @@ impl Tracker {
         let predicted = self.predicted();
         let mut q = predicted.clone();
         let mut report = FrameReport::default();
+        self.work.seen_by = [0; MAX_LINKS];
         for k in 0..self.config.iterations.max(1) {
             let Some(step) = self.iterate(&q, &predicted, measurer, k, &mut report) else {
                 report.lost = true;
@@ -686,6 +691,10 @@ impl Tracker {
         report.links_skipped = 0;
         let config = &self.config;
         let estimator = config.estimator.for_cameras(self.cameras.len());
+        let mut single_view = estimator;
+        single_view.width_weight = config.estimator.single_view_width_weight;
+        let seen_before = work.seen_by;
+        let mut seen_now = [0u8; MAX_LINKS];
         let fill_on = config.fill.is_on();
         for (camera_index, ((camera, view), fill)) in self
             .cameras
@@ -721,6 +730,12 @@ impl Tracker {
                 report.features_expected += work.features.expected;
                 report.features_masked += work.features.masked;
                 let link = &view.links[index];
+                let frame = usize::from(link.frame);
+                if found > 0 {
+                    if let Some(n) = seen_now.get_mut(frame) {
+                        *n = n.saturating_add(1);
+                    }
+                }
                 let mut samples = fill
                     .points
                     .iter()
@@ -734,12 +749,15 @@ impl Tracker {
                 work.jacobian
                     .compute(&self.model, &work.poses, camera, link);
                 if found > 0 {
+                    let alone = single_view.width_weight > 0.0
+                        && self.cameras.len() > 1
+                        && seen_before.get(frame) == Some(&1);
                     add_link_rows(
                         &mut work.normal,
                         link,
                         &work.features,
                         &work.jacobian,
-                        &estimator,
+                        if alone { &single_view } else { &estimator },
                         self.free,
                     );
                 }
@@ -756,6 +774,7 @@ impl Tracker {
                 }
             }
         }
+        work.seen_by = seen_now;
         // The lost test weighs the fingers' fit alone: the palm's rows below count neither
         // towards the found share nor the residual. A palm the image does not show as the
         // model's bright box (a sleeve, a glove, a renderer's other palm) must not make every

@@ -4,8 +4,9 @@
 //! weights, `sj`, `st`, `sq` the conditioning; `iters` (the tracker's Gauss–Newton iterations),
 //! `liters` (a search leaf's or local start's), `predict`, `window`, `margin` (the narrowed
 //! windows' margin, px), `contrast` (the smallest edge), `slices`, `palm`,
-//! `palmw`, `residual` (0 edge points, 1 axis lines, 2 axis points), `widthw` and `widthw1`
-//! (the width rows' weight with two cameras and with one), `tipw`, `fvf`, `outer`, `knuckle`
+//! `palmw`, `residual` (0 edge points, 1 axis lines, 2 axis points), `widthw`, `widthw1`
+//! and `widthws` (the width rows' weight with two cameras, with one, and for a link only one
+//! of two sees), `tipw`, `fvf`, `outer`, `knuckle`
 //! (0: no knuckle tips), `bounds` (0: the plain step); `angle` the edge-direction limit in degrees (90: off); `huber`, `tukey` the robust
 //! kernel's px; `k`, `s`, `spawn`, `step`, `smem`, `switch` the hypotheses (their count, scoring
 //! period, samples, their step in spread units, score memory, switch margin), `si`, `oi` (a

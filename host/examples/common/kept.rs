@@ -155,6 +155,7 @@ pub fn variant(text: &str) -> Result<(TrackerConfig, TrackOptions)> {
             "palmw" => c.estimator.palm_edge_weight = f,
             "widthw" => c.estimator.width_weight = f,
             "widthw1" => c.estimator.one_camera_width_weight = f,
+            "widthws" => c.estimator.single_view_width_weight = f,
             "residual" => {
                 c.estimator.residual = match f as u8 {
                     0 => ResidualKind::EdgePoints,
