@@ -115,12 +115,12 @@ fn one_cameras_width_rows_bring_a_pushed_palm_back_to_its_depth() {
     );
 }
 
-/// With two cameras, a link only one of them finds features on can read its width as one
-/// camera's tracker does (`EstimatorConfig::single_view_width_weight`, off by default, the
-/// lead of stop 77): here the second camera looks away from the hand, so every link is seen
-/// by the first alone, and at the one camera's weight (0.5) the pushed palm comes back as
-/// the one camera's does. Without those rows two cameras' tracker gives such links no width
-/// rows at all.
+/// With two cameras, a link only one of them finds features on reads its width as one
+/// camera's tracker does (`EstimatorConfig::single_view_width_weight`, 0.25 by default since
+/// stop 77): here the second camera looks away from the hand, so every link is seen by the
+/// first alone, and at the one camera's weight (0.5) the pushed palm comes back as the one
+/// camera's does; at the default, part of the way. Without those rows two cameras' tracker
+/// gives such links no width rows at all.
 #[test]
 fn a_link_one_of_two_cameras_sees_reads_its_width() {
     let model = Model::hand().unwrap();
@@ -144,12 +144,20 @@ fn a_link_one_of_two_cameras_sees_reads_its_width() {
         Renderer::new(&model, &camera, settings),
         Renderer::new(&model, &away, settings),
     ];
-    let without = TrackerConfig::default();
-    let mut with = without;
-    with.estimator.single_view_width_weight = 0.5;
+    let default = TrackerConfig::default();
+    assert!(
+        default.estimator.single_view_width_weight > 0.0,
+        "on by default"
+    );
+    let mut without = default;
+    without.estimator.single_view_width_weight = 0.0;
+    // At one camera's weight, to compare with one camera's tracker.
+    let mut with = default;
+    with.estimator.single_view_width_weight = default.estimator.one_camera_width_weight;
     // Measured (60 frames): pushed −40 / −20 mm, 6.6 / 1.6 mm off in depth with the rows at
-    // 0.5, 9.6 / 3.8 without (one camera alone: 6.7 / 1.8 and 9.6 / 3.8); at 0.25, −40 mm
-    // ends 8.1 mm off. The first iteration of a frame has no count yet, so no such rows.
+    // 0.5, 9.6 / 3.8 without (one camera alone: 6.7 / 1.8 and 9.6 / 3.8); at the default
+    // 0.25, −40 mm ends 8.1 mm off. The first iteration of a frame has no count yet, so no
+    // such rows.
     let palm = Vector3::new(
         truth[TRANSLATION[0]],
         truth[TRANSLATION[1]],
@@ -189,4 +197,11 @@ fn a_link_one_of_two_cameras_sees_reads_its_width() {
             "pushed {push:+} mm: {on:.1} mm off with the rows, {off:.1} without"
         );
     }
+    let at_default = error_after(-40.0, default);
+    let off = error_after(-40.0, without);
+    println!("at the default weight, pushed -40 mm: {at_default:.1} mm off, {off:.1} without");
+    assert!(
+        at_default < 0.9 * off,
+        "at the default weight, pushed -40 mm: {at_default:.1} mm off, {off:.1} without"
+    );
 }

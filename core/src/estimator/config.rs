@@ -103,9 +103,8 @@ pub struct EstimatorConfig {
     /// With two or more cameras, [`width_weight`](Self::width_weight) for a link only one of
     /// them found features on in the frame's previous iteration (none on a frame's first):
     /// to that camera alone the link's width is its one reading of depth, as to a tracker with
-    /// one camera. 0 (the default): no width rows there. Measured on the robustness sweep at
-    /// 0.25, the lead for the next default (`docs/robustness.md`, "Stop 77: a link one of two
-    /// cameras sees").
+    /// one camera. 0: no width rows there. Default 0.25, measured on the robustness sweep
+    /// (`docs/robustness.md`, "Stop 77: a link one of two cameras sees").
     pub single_view_width_weight: f32,
     /// Solve each step with the joints it would carry out of their ranges held at their
     /// bounds and the other states solved again for it
@@ -146,7 +145,7 @@ impl Default for EstimatorConfig {
             palm_edge_weight: 1.0,
             width_weight: 0.0,
             one_camera_width_weight: 0.5,
-            single_view_width_weight: 0.0,
+            single_view_width_weight: 0.25,
             bounded_step: false,
         }
     }
