@@ -48,6 +48,15 @@ fn camera_over(q: &[f32]) -> Camera {
     .unwrap()
 }
 
+/// The still hand's renders: supersampled twice, noise σ 2 grey levels.
+fn still_hand_settings() -> RenderSettings {
+    RenderSettings {
+        supersample: 2,
+        noise_sigma: 2.0,
+        ..RenderSettings::default()
+    }
+}
+
 /// The palm's depth error (mm) after `frames` frames of the still `truth`, tracked from
 /// `truth` with the palm moved `push_mm` along the camera's ray, under `config`.
 fn depth_error_after(
@@ -79,11 +88,7 @@ fn one_cameras_width_rows_bring_a_pushed_palm_back_to_its_depth() {
     let model = Model::hand().unwrap();
     let truth = bent_hand();
     let camera = camera_over(&truth);
-    let settings = RenderSettings {
-        supersample: 2,
-        noise_sigma: 2.0,
-        ..RenderSettings::default()
-    };
+    let settings = still_hand_settings();
     let renderer = Renderer::new(&model, &camera, settings);
     let with = TrackerConfig::default();
     assert!(
@@ -135,11 +140,7 @@ fn a_link_one_of_two_cameras_sees_reads_its_width() {
         400.0,
     )
     .unwrap();
-    let settings = RenderSettings {
-        supersample: 2,
-        noise_sigma: 2.0,
-        ..RenderSettings::default()
-    };
+    let settings = still_hand_settings();
     let renderers = [
         Renderer::new(&model, &camera, settings),
         Renderer::new(&model, &away, settings),
