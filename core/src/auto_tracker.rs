@@ -367,36 +367,15 @@ impl AutoTracker {
         config: TrackerConfig,
         acquire: AcquireConfig,
     ) -> Result<Self, AutoError> {
-        let tracker = Tracker::new(model, cameras, base, free, config)?;
-        let volume = WorkingVolume::from_cameras(cameras, FALLBACK_DEPTH_MM);
-        let acquirer = Acquirer::new(tracker.model(), base, tracker.free(), volume, acquire);
-        let mut held = [0.0f32; MAX_STATES];
-        for (h, s) in held.iter_mut().zip(tracker.state()) {
-            *h = *s;
-        }
-        Ok(AutoTracker {
-            multi: MultiTracker::new(tracker, HypothesesConfig::default()),
-            finder: Finder::new(acquirer, FinderConfig::default()),
-            status: Status::Searching,
-            lost_run: 0,
-            held,
-            ever_tracked: false,
-            local_left: 0,
-            following: None,
-            pursued: None,
-            local_in_view: 0,
-            recovery: Recovery::Search,
-            watch: Watch::new(WatchConfig::default()),
-            vouched: heapless::Vec::new(),
-            hypotheses: HypothesesConfig::default(),
-            confirm_left: 0,
-            settle_left: 0,
-            confirm_scores: (0.0, 0),
-            polish_left: 0,
-            probation: None,
-            rival_depth_mm: None,
-            undecided: false,
-        })
+        AutoTracker::started(
+            model,
+            cameras,
+            base,
+            free,
+            config,
+            acquire,
+            Status::Searching,
+        )
     }
 
     /// A tracker for `model` seen by `cameras` that starts by tracking from `initial` (a known
@@ -409,11 +388,65 @@ impl AutoTracker {
         config: TrackerConfig,
         acquire: AcquireConfig,
     ) -> Result<Self, AutoError> {
-        let mut auto = AutoTracker::new(model, cameras, initial, free, config, acquire)?;
-        auto.vouched = auto.multi.tracker().memory().state;
-        auto.status = Status::Tracking;
-        auto.ever_tracked = true;
-        Ok(auto)
+        AutoTracker::started(
+            model,
+            cameras,
+            initial,
+            free,
+            config,
+            acquire,
+            Status::Tracking,
+        )
+    }
+
+    /// [`AutoTracker::new`] (`status` searching) or [`AutoTracker::tracking`] (tracking from
+    /// `base`), built once and returned without a further copy: the value is tens of KB, and
+    /// a small board pays every copy in stack.
+    fn started(
+        model: Model,
+        cameras: &[Camera],
+        base: &[f32],
+        free: FreeMask,
+        config: TrackerConfig,
+        acquire: AcquireConfig,
+        status: Status,
+    ) -> Result<Self, AutoError> {
+        let tracker = Tracker::new(model, cameras, base, free, config)?;
+        let volume = WorkingVolume::from_cameras(cameras, FALLBACK_DEPTH_MM);
+        let acquirer = Acquirer::new(tracker.model(), base, tracker.free(), volume, acquire);
+        let mut held = [0.0f32; MAX_STATES];
+        for (h, s) in held.iter_mut().zip(tracker.state()) {
+            *h = *s;
+        }
+        let tracking = status == Status::Tracking;
+        let vouched = if tracking {
+            tracker.memory().state
+        } else {
+            heapless::Vec::new()
+        };
+        Ok(AutoTracker {
+            multi: MultiTracker::new(tracker, HypothesesConfig::default()),
+            finder: Finder::new(acquirer, FinderConfig::default()),
+            status,
+            lost_run: 0,
+            held,
+            ever_tracked: tracking,
+            local_left: 0,
+            following: None,
+            pursued: None,
+            local_in_view: 0,
+            recovery: Recovery::Search,
+            watch: Watch::new(WatchConfig::default()),
+            vouched,
+            hypotheses: HypothesesConfig::default(),
+            confirm_left: 0,
+            settle_left: 0,
+            confirm_scores: (0.0, 0),
+            polish_left: 0,
+            probation: None,
+            rival_depth_mm: None,
+            undecided: false,
+        })
     }
 
     /// Bytes of edge-map buffer camera `camera` needs.

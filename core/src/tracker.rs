@@ -255,12 +255,17 @@ impl Tracker {
         let mask = free.with_whole_quaternion();
         let poses = Poses::compute(&model, initial).map_err(TrackerError::State)?;
         let fingers = Fingers::of(&model);
-        let mut tracker = Tracker {
+        // `Tracker::reset(initial)`'s work, done before the value is built so that it is
+        // built once, in its place (its poses are `poses`, just computed from `initial`).
+        let mut state = Vec::new();
+        let _ = state.extend_from_slice(initial);
+        renormalise_quaternion(&mut state);
+        Ok(Tracker {
             fingers,
             shading_calls: 0,
             model,
             cameras,
-            state: Vec::new(),
+            state,
             velocity: None,
             silhouette_reference: None,
             free: mask,
@@ -276,9 +281,7 @@ impl Tracker {
                 shading: ShadingCache::default(),
                 seen_by: [0; MAX_LINKS],
             },
-        };
-        tracker.reset(initial)?;
-        Ok(tracker)
+        })
     }
 
     /// New cameras and parameters for the frames to come, keeping what the tracker knows of

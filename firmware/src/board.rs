@@ -5,6 +5,7 @@ use core::convert::Infallible;
 use digiteyes_core::acquire::AcquireConfig;
 use digiteyes_core::auto_tracker::{AutoError, AutoTracker};
 use digiteyes_core::camera::Camera;
+use digiteyes_core::config::MAX_STATES;
 use digiteyes_core::estimator::FreeMask;
 use digiteyes_core::frame::FrameView;
 use digiteyes_core::hypotheses::HypothesesConfig;
@@ -343,20 +344,11 @@ where
             .setup
             .is_some_and(|s| s.camera == camera && s.config == config && s.acquire == acquire);
         if !unchanged {
-            if let Some(auto) = self.tracker.take() {
-                // Keep the state, the free states and the status with the new camera and
-                // parameters. `AutoTracker` cannot be reconfigured in place, so the motion
-                // (the velocity of the next prediction) starts over; a `Configure` that
-                // changes neither keeps everything (docs/protocol.md §6).
-                let rebuilt = rebuild(&auto, camera, config, acquire, hypotheses);
-                match rebuilt {
-                    Ok(fresh) => self.tracker = Some(fresh),
-                    Err(refusal) => {
-                        self.tracker = Some(auto);
-                        return Err(refusal);
-                    }
-                }
-            }
+            // Keep the state, the free states and the status with the new camera and
+            // parameters. `AutoTracker` cannot be reconfigured in place, so the motion (the
+            // velocity of the next prediction) starts over; a `Configure` that changes
+            // neither keeps everything (docs/protocol.md §6).
+            rebuild(&mut self.tracker, camera, config, acquire, hypotheses)?;
         } else if let Some(auto) = self.tracker.as_mut() {
             // Only the count (or nothing) changed: the status machine keeps its motion, and
             // the hypotheses beyond a smaller count are dropped.
@@ -375,16 +367,12 @@ where
 
     #[inline(never)]
     fn reset(&mut self, reset: &Reset) -> Result<(), S::Error> {
-        let built = match &self.setup {
+        let built = match self.setup {
             None => Err(Refusal::NotConfigured),
-            Some(setup) => {
-                let setup = *setup;
-                self.build_tracker(&setup, &reset.q, reset.free, reset.start)
-            }
+            Some(setup) => self.build_tracker(&setup, &reset.q, reset.free, reset.start),
         };
         match built {
-            Ok(tracker) => {
-                self.tracker = Some(tracker);
+            Ok(()) => {
                 self.measuring = None;
                 self.held = None;
                 self.abandon_upload()?;
@@ -395,26 +383,27 @@ where
         }
     }
 
+    /// Builds the status machine for `setup` from `q` into `self.tracker` (the old one kept
+    /// on a refusal). Built where it is kept, not returned: the tracker is tens of KB, and
+    /// every copy of it by value costs that much stack (docs/boards/qemu-m7.md, "Stack").
     fn build_tracker(
-        &self,
+        &mut self,
         setup: &Setup,
         q: &[f32],
         free: u32,
         start: Start,
-    ) -> Result<AutoTracker, Refusal> {
+    ) -> Result<(), Refusal> {
         let model = self.model.clone().ok_or(Refusal::BadState)?;
         if q.len() != model.n_states() || q.iter().any(|v| !v.is_finite()) {
             return Err(Refusal::BadState);
         }
         let cameras = [setup.camera];
         let (free, config, acquire) = (FreeMask(free), setup.config, setup.acquire);
-        let mut auto = match start {
+        let built = match start {
             Start::Given => AutoTracker::tracking(model, &cameras, q, free, config, acquire),
             Start::Search => AutoTracker::new(model, &cameras, q, free, config, acquire),
-        }
-        .map_err(refusal_of)?;
-        auto.set_hypotheses(setup.hypotheses);
-        Ok(auto)
+        };
+        into_slot(&mut self.tracker, built, setup.hypotheses)
     }
 
     /// Drops and reports a partly uploaded frame: after a new setup its chunks no longer fit.
@@ -606,7 +595,7 @@ where
             clock_hz: self.clock.hz(),
             capacities: Capacities {
                 states: model.map_or(0, |m| m.n_states() as u8),
-                max_states: digiteyes_core::config::MAX_STATES as u8,
+                max_states: MAX_STATES as u8,
                 max_links: digiteyes_core::config::MAX_LINKS as u8,
                 max_frame_bytes: u32::try_from(self.frame.len()).unwrap_or(u32::MAX),
                 max_chunk: MAX_CHUNK as u16,
@@ -630,27 +619,46 @@ where
     }
 }
 
-/// `auto` again with a new camera and parameters, from its state, free states and status
-/// (tracking from its state, or searching with its state as the fixed states' values).
+/// The tracker in `slot` (if any) again with a new camera and parameters, from its state, free
+/// states and status (tracking from its state, or searching with its state as the fixed
+/// states' values); on a refusal the old one stays.
 fn rebuild(
-    auto: &AutoTracker,
+    slot: &mut Option<AutoTracker>,
     camera: Camera,
     config: TrackerConfig,
     acquire: AcquireConfig,
     hypotheses: HypothesesConfig,
-) -> Result<AutoTracker, Refusal> {
+) -> Result<(), Refusal> {
+    let Some(auto) = slot.as_ref() else {
+        return Ok(());
+    };
     let tracker = auto.tracker();
     let (model, free, cameras) = (tracker.model().clone(), tracker.free(), [camera]);
-    let q = auto.state();
-    let mut fresh = match auto.status() {
+    let q: Vec<f32, MAX_STATES> = auto.state().iter().copied().collect();
+    let built = match auto.status() {
         Status::Tracking | Status::Lost => {
-            AutoTracker::tracking(model, &cameras, q, free, config, acquire)
+            AutoTracker::tracking(model, &cameras, &q, free, config, acquire)
         }
-        Status::Searching => AutoTracker::new(model, &cameras, q, free, config, acquire),
+        Status::Searching => AutoTracker::new(model, &cameras, &q, free, config, acquire),
+    };
+    into_slot(slot, built, hypotheses)
+}
+
+/// Moves a tracker just built into `slot` with `hypotheses` set, or keeps the slot as it was
+/// and gives the refusal for the error. The value goes from the builder's result straight to
+/// its slot: one copy of it on the stack, not one per step.
+fn into_slot(
+    slot: &mut Option<AutoTracker>,
+    built: Result<AutoTracker, AutoError>,
+    hypotheses: HypothesesConfig,
+) -> Result<(), Refusal> {
+    match built {
+        Ok(auto) => {
+            slot.insert(auto).set_hypotheses(hypotheses);
+            Ok(())
+        }
+        Err(e) => Err(refusal_of(e)),
     }
-    .map_err(refusal_of)?;
-    fresh.set_hypotheses(hypotheses);
-    Ok(fresh)
 }
 
 /// The refusal for a tracker that could not be built.

@@ -716,3 +716,47 @@ fn a_second_configure_keeps_the_motion() {
     };
     assert_eq!(last_state(true), last_state(false));
 }
+
+#[test]
+fn a_refused_reset_keeps_the_running_tracker_and_its_motion() {
+    let model = Model::hand().unwrap();
+    let cam = camera();
+    let q0 = pose(&model, 0.2);
+    let frames: Vec<Vec<u8>> = [0.26f32, 0.32, 0.38, 0.44]
+        .iter()
+        .map(|&bend| render(&model, &cam, &pose(&model, bend)))
+        .collect();
+    let far = pose(&model, 1.2);
+    let last_state = |refused: bool| {
+        let mut buffer = vec![0u8; FRAME_BYTES];
+        let mut board = ready_board(&mut buffer, &q0);
+        for (n, pixels) in frames.iter().enumerate() {
+            if refused && n == 3 {
+                // Refused by the tracker's own constructor (a free state beyond the model),
+                // after the board has checked the state: the new tracker is built and
+                // dropped, the running one must stay.
+                board.serial_mut().send(&HostMessage::Reset(Reset {
+                    q: far.iter().copied().collect(),
+                    free: 1 << 30,
+                    start: Start::Given,
+                }));
+            }
+            board
+                .serial_mut()
+                .send_frame(n as u32, WIDTH as u16, HEIGHT as u16, pixels);
+            board.poll().unwrap();
+        }
+        let got = board.serial_mut().received();
+        if refused {
+            assert!(
+                got.contains(&BoardMessage::Nak(Command::Reset, Refusal::BadFreeMask)),
+                "{got:?}"
+            );
+        }
+        match got.last() {
+            Some(BoardMessage::State(s)) => s.q.clone(),
+            other => panic!("{other:?}"),
+        }
+    };
+    assert_eq!(last_state(true), last_state(false));
+}
