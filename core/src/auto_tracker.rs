@@ -55,12 +55,13 @@ use crate::camera::{palm_depth_mm, Camera};
 use crate::config::{MAX_CAMERAS, MAX_HYPOTHESES, MAX_STATES};
 use crate::estimator::FreeMask;
 use crate::frame::FrameView;
+use crate::hypotheses::fingers::Fingers;
 use crate::hypotheses::{DepthAnchor, HypothesesConfig, Hypothesis, MultiReport, MultiTracker};
 use crate::likelihood::{BuiltEdges, EdgeMap, LikelihoodConfig, LikelihoodError, Reads, Scene};
 use crate::model::Model;
 use crate::motion::PriorWeights;
 pub use crate::status::Status;
-use crate::tracker::{FrameReport, Tracker, TrackerConfig, TrackerError};
+use crate::tracker::{FrameReport, TrackMemory, Tracker, TrackerConfig, TrackerError};
 use crate::watch::{Watch, WatchConfig};
 
 /// Lost frames in a row after which the tracker gives the hand up and searches again.
@@ -411,21 +412,30 @@ impl AutoTracker {
         acquire: AcquireConfig,
         status: Status,
     ) -> Result<Self, AutoError> {
-        let tracker = Tracker::new(model, cameras, base, free, config)?;
+        let start = Tracker::checked_start(&model, cameras, base, free)?;
         let volume = WorkingVolume::from_cameras(cameras, FALLBACK_DEPTH_MM);
-        let acquirer = Acquirer::new(tracker.model(), base, tracker.free(), volume, acquire);
-        let mut held = [0.0f32; MAX_STATES];
-        for (h, s) in held.iter_mut().zip(tracker.state()) {
-            *h = *s;
-        }
+        let acquirer = Acquirer::new(&model, base, start.free, volume, acquire);
+        let held = padded(&start.state);
+        // A fresh tracker's memory: its start state, no motion, no silhouette reference.
+        let memory = TrackMemory {
+            state: start.state.clone(),
+            velocity: None,
+            silhouette_reference: None,
+        };
+        let fingers = Fingers::of(&model);
         let tracking = status == Status::Tracking;
         let vouched = if tracking {
-            tracker.memory().state
+            start.state.clone()
         } else {
             heapless::Vec::new()
         };
         Ok(AutoTracker {
-            multi: MultiTracker::new(tracker, HypothesesConfig::default()),
+            multi: MultiTracker::around(
+                Tracker::started(model, start, config),
+                memory,
+                fingers,
+                HypothesesConfig::default(),
+            ),
             finder: Finder::new(acquirer, FinderConfig::default()),
             status,
             lost_run: 0,

@@ -237,6 +237,16 @@ pub struct Tracker {
     work: Workspace,
 }
 
+/// A tracker's start, checked ([`Tracker::checked_start`]): its cameras, free states (the
+/// whole quaternion freed with any of it), the poses of its start state and that state (its
+/// quaternion renormalised).
+pub(crate) struct TrackerStart {
+    cameras: Vec<Camera, MAX_CAMERAS>,
+    pub(crate) free: FreeMask,
+    poses: Poses,
+    pub(crate) state: Vec<f32, MAX_STATES>,
+}
+
 impl Tracker {
     /// A tracker starting from `initial` (one value per model state: quaternion, mm, rad),
     /// estimating the states in `free` ([`FreeMask::all`] for every state). Freeing any
@@ -248,30 +258,51 @@ impl Tracker {
         free: FreeMask,
         config: TrackerConfig,
     ) -> Result<Self, TrackerError> {
+        let start = Tracker::checked_start(&model, cameras, initial, free)?;
+        Ok(Tracker::started(model, start, config))
+    }
+
+    /// What [`Tracker::new`] checks and computes of its arguments before the tracker is
+    /// built: the whole fallible part, so that the value itself is built once, in its place
+    /// (a board pays every copy of it in stack).
+    pub(crate) fn checked_start(
+        model: &Model,
+        cameras: &[Camera],
+        initial: &[f32],
+        free: FreeMask,
+    ) -> Result<TrackerStart, TrackerError> {
         let cameras = checked_cameras(cameras)?;
         if let Some(s) = free.first_beyond(model.n_states()) {
             return Err(TrackerError::BadFreeState(s));
         }
-        let mask = free.with_whole_quaternion();
-        let poses = Poses::compute(&model, initial).map_err(TrackerError::State)?;
-        let fingers = Fingers::of(&model);
-        // `Tracker::reset(initial)`'s work, done before the value is built so that it is
-        // built once, in its place (its poses are `poses`, just computed from `initial`).
+        let poses = Poses::compute(model, initial).map_err(TrackerError::State)?;
+        // `Tracker::reset(initial)`'s work (its poses are `poses`, just computed).
         let mut state = Vec::new();
         let _ = state.extend_from_slice(initial);
         renormalise_quaternion(&mut state);
-        Ok(Tracker {
-            fingers,
+        Ok(TrackerStart {
+            cameras,
+            free: free.with_whole_quaternion(),
+            poses,
+            state,
+        })
+    }
+
+    /// The tracker of a checked start ([`Tracker::checked_start`]).
+    #[inline]
+    pub(crate) fn started(model: Model, start: TrackerStart, config: TrackerConfig) -> Tracker {
+        Tracker {
+            fingers: Fingers::of(&model),
             shading_calls: 0,
             model,
-            cameras,
-            state,
+            cameras: start.cameras,
+            state: start.state,
             velocity: None,
             silhouette_reference: None,
-            free: mask,
+            free: start.free,
             config,
             work: Workspace {
-                poses,
+                poses: start.poses,
                 views: Default::default(),
                 outline: PalmOutline::new(),
                 features: LinkFeatures::default(),
@@ -281,7 +312,7 @@ impl Tracker {
                 shading: ShadingCache::default(),
                 seen_by: [0; MAX_LINKS],
             },
-        })
+        }
     }
 
     /// New cameras and parameters for the frames to come, keeping what the tracker knows of

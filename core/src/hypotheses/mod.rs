@@ -109,9 +109,22 @@ pub struct MultiTracker {
 impl MultiTracker {
     /// Hypotheses around `tracker`, which starts as the only one.
     pub fn new(tracker: Tracker, config: HypothesesConfig) -> Self {
-        let mut hypotheses = Vec::new();
-        let _ = hypotheses.push(Hypothesis::fresh(tracker.memory()));
+        let memory = tracker.memory();
         let fingers = fingers::Fingers::of(tracker.model());
+        MultiTracker::around(tracker, memory, fingers, config)
+    }
+
+    /// [`MultiTracker::new`] with `tracker`'s memory and its model's fingers given, so that a
+    /// tracker built in the call goes straight into its place.
+    #[inline]
+    pub(crate) fn around(
+        tracker: Tracker,
+        memory: TrackMemory,
+        fingers: fingers::Fingers,
+        config: HypothesesConfig,
+    ) -> Self {
+        let mut hypotheses = Vec::new();
+        let _ = hypotheses.push(Hypothesis::fresh(memory));
         MultiTracker {
             tracker,
             config,
