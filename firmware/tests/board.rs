@@ -679,84 +679,58 @@ fn a_chunk_over_max_chunk_drops_its_frame() {
     assert_eq!(board.stats().dropped.too_large, 2);
 }
 
+/// A board started at a bend of 0.2 rad tracks four frames bending further, with `message`
+/// sent before the last: what it answered, and the last `State`'s state.
+fn bend_with(message: Option<&HostMessage<'_>>) -> (Vec<BoardMessage>, Vec<f32>) {
+    let model = Model::hand().unwrap();
+    let cam = camera();
+    let mut buffer = vec![0u8; FRAME_BYTES];
+    let mut board = ready_board(&mut buffer, &pose(&model, 0.2));
+    for (n, bend) in [0.26f32, 0.32, 0.38, 0.44].into_iter().enumerate() {
+        if let (3, Some(message)) = (n, message) {
+            board.serial_mut().send(message);
+        }
+        let pixels = render(&model, &cam, &pose(&model, bend));
+        board
+            .serial_mut()
+            .send_frame(n as u32, WIDTH as u16, HEIGHT as u16, &pixels);
+        board.poll().unwrap();
+    }
+    let got = board.serial_mut().received();
+    let q = match got.last() {
+        Some(BoardMessage::State(s)) => s.q.to_vec(),
+        other => panic!("{other:?}"),
+    };
+    (got, q)
+}
+
 /// A second `Configure` keeps the state, the free states and the motion: the next frame's
 /// state is bit-equal to that of a board that was not reconfigured.
 #[test]
 fn a_second_configure_keeps_the_motion() {
-    let model = Model::hand().unwrap();
-    let cam = camera();
-    let q0 = pose(&model, 0.2);
-    let frames: Vec<Vec<u8>> = [0.26f32, 0.32, 0.38, 0.44]
-        .iter()
-        .map(|&bend| render(&model, &cam, &pose(&model, bend)))
-        .collect();
-    let last_state = |reconfigure: bool| {
-        let mut buffer = vec![0u8; FRAME_BYTES];
-        let mut board = ready_board(&mut buffer, &q0);
-        for (n, pixels) in frames.iter().enumerate() {
-            if reconfigure && n == 3 {
-                board.serial_mut().send(&configure(0, 0));
-            }
-            board
-                .serial_mut()
-                .send_frame(n as u32, WIDTH as u16, HEIGHT as u16, pixels);
-            board.poll().unwrap();
-        }
-        let got = board.serial_mut().received();
-        if reconfigure {
-            assert!(
-                got.contains(&BoardMessage::Ack(Command::Configure)),
-                "{got:?}"
-            );
-        }
-        match got.last() {
-            Some(BoardMessage::State(s)) => s.q.clone(),
-            other => panic!("{other:?}"),
-        }
-    };
-    assert_eq!(last_state(true), last_state(false));
+    let (got, reconfigured) = bend_with(Some(&configure(0, 0)));
+    assert!(
+        got.contains(&BoardMessage::Ack(Command::Configure)),
+        "{got:?}"
+    );
+    assert_eq!(reconfigured, bend_with(None).1);
 }
 
+/// A `Reset` the tracker's own constructor refuses (a free state beyond the model, after the
+/// board has checked the state) builds nothing in the board's slot: the running tracker, its
+/// state and its motion stay, bit for bit.
 #[test]
 fn a_refused_reset_keeps_the_running_tracker_and_its_motion() {
     let model = Model::hand().unwrap();
-    let cam = camera();
-    let q0 = pose(&model, 0.2);
-    let frames: Vec<Vec<u8>> = [0.26f32, 0.32, 0.38, 0.44]
-        .iter()
-        .map(|&bend| render(&model, &cam, &pose(&model, bend)))
-        .collect();
-    let far = pose(&model, 1.2);
-    let last_state = |refused: bool| {
-        let mut buffer = vec![0u8; FRAME_BYTES];
-        let mut board = ready_board(&mut buffer, &q0);
-        for (n, pixels) in frames.iter().enumerate() {
-            if refused && n == 3 {
-                // Refused by the tracker's own constructor (a free state beyond the model),
-                // after the board has checked the state: the new tracker is built and
-                // dropped, the running one must stay.
-                board.serial_mut().send(&HostMessage::Reset(Reset {
-                    q: far.iter().copied().collect(),
-                    free: 1 << 30,
-                    start: Start::Given,
-                }));
-            }
-            board
-                .serial_mut()
-                .send_frame(n as u32, WIDTH as u16, HEIGHT as u16, pixels);
-            board.poll().unwrap();
-        }
-        let got = board.serial_mut().received();
-        if refused {
-            assert!(
-                got.contains(&BoardMessage::Nak(Command::Reset, Refusal::BadFreeMask)),
-                "{got:?}"
-            );
-        }
-        match got.last() {
-            Some(BoardMessage::State(s)) => s.q.clone(),
-            other => panic!("{other:?}"),
-        }
-    };
-    assert_eq!(last_state(true), last_state(false));
+    let refused = HostMessage::Reset(Reset {
+        q: pose(&model, 1.2).iter().copied().collect(),
+        free: 1 << 30,
+        start: Start::Given,
+    });
+    let (got, kept) = bend_with(Some(&refused));
+    assert!(
+        got.contains(&BoardMessage::Nak(Command::Reset, Refusal::BadFreeMask)),
+        "{got:?}"
+    );
+    assert_eq!(kept, bend_with(None).1);
 }
