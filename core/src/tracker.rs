@@ -61,6 +61,14 @@ fn checked_cameras(cameras: &[Camera]) -> Result<Vec<Camera, MAX_CAMERAS>, Track
     Ok(cameras)
 }
 
+/// The state a tracker starts (or restarts) from: `state`, its quaternion renormalised (empty
+/// if it does not fit [`MAX_STATES`]; its poses have been checked by then).
+fn start_state(state: &[f32]) -> Vec<f32, MAX_STATES> {
+    let mut q = Vec::from_slice(state).unwrap_or_default();
+    renormalise_quaternion(&mut q);
+    q
+}
+
 /// How far beyond a frame's edges (share of its width and height) the palm's origin may
 /// project before a frame is `lost` for having left every camera's view.
 pub const VIEW_SLACK: f32 = 0.25;
@@ -276,15 +284,11 @@ impl Tracker {
             return Err(TrackerError::BadFreeState(s));
         }
         let poses = Poses::compute(model, initial).map_err(TrackerError::State)?;
-        // `Tracker::reset(initial)`'s work (its poses are `poses`, just computed).
-        let mut state = Vec::new();
-        let _ = state.extend_from_slice(initial);
-        renormalise_quaternion(&mut state);
         Ok(TrackerStart {
             cameras,
             free: free.with_whole_quaternion(),
             poses,
-            state,
+            state: start_state(initial),
         })
     }
 
@@ -404,9 +408,7 @@ impl Tracker {
             .poses
             .update(&self.model, state)
             .map_err(TrackerError::State)?;
-        self.state.clear();
-        let _ = self.state.extend_from_slice(state);
-        renormalise_quaternion(&mut self.state);
+        self.state = start_state(state);
         // The silhouette reference is the images' level, not the motion's: it stays.
         self.velocity = None;
         Ok(())
