@@ -66,8 +66,9 @@ pub struct TrackArgs {
     /// After every N-th frame tracked, move one finger in turn where the hand's shading
     /// says it lies (0: never, the default). Costs up to 16 residuals over a finger a frame.
     /// It models the hand as one matte grey: on glossy, shadowed hands of uneven grey it
-    /// helped two cameras a little and one camera not at all; docs/robustness.md, "The
-    /// shading pulls a finger back" and "A surface the shading fit does not model".
+    /// helped two cameras a little and one camera not at all, and under the tracker's
+    /// defaults since stop 77 neither; docs/robustness.md, "The shading pulls a finger back",
+    /// "A surface the shading fit does not model" and "Stop 78".
     #[arg(long, value_name = "N")]
     pub shading_refine: Option<u8>,
     /// No progress bar.
